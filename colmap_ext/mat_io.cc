@@ -1,0 +1,55 @@
+#include "colmap_ext/mat_io.h"
+
+#include <cstring>
+#include <fstream>
+#include <limits>
+
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+static_assert(sizeof(float) == 4, "float32 expected");
+
+FloatMap ReadMat(std::istream& in, const std::string& source) {
+  // The header is read field by field as COLMAP does: W & H & C &; no newline may follow.
+  long width = 0, height = 0, channels = 0;
+  char sep1 = 0, sep2 = 0, sep3 = 0;
+  in >> width >> sep1 >> height >> sep2 >> channels >> sep3;
+  THROW_IF(!in || sep1 != '&' || sep2 != '&' || sep3 != '&',
+           source << ": not a COLMAP Mat file (expected a header \"W&H&C&\")");
+  THROW_IF(width <= 0 || height <= 0 || channels <= 0 || width > (1 << 16) ||
+               height > (1 << 16) || channels > 64,
+           source << ": invalid Mat dimensions " << width << "x" << height << "x" << channels);
+  FloatMap map(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels));
+  const std::streamsize num_bytes =
+      static_cast<std::streamsize>(map.Data().size() * sizeof(float));
+  in.read(reinterpret_cast<char*>(map.Data().data()), num_bytes);
+  THROW_IF(in.gcount() != num_bytes, source << ": truncated Mat file: expected " << num_bytes
+                                            << " bytes of data for " << width << "x" << height
+                                            << "x" << channels << ", found " << in.gcount());
+  THROW_IF(in.peek() != std::char_traits<char>::eof(),
+           source << ": Mat file has bytes after its " << width << "x" << height << "x"
+                  << channels << " payload");
+  return map;
+}
+
+FloatMap ReadMat(const std::string& path) {
+  RequireFile(path, "Mat file");
+  std::ifstream in(path, std::ios::binary);
+  THROW_IF(!in, "Cannot open " << path);
+  return ReadMat(in, path);
+}
+
+void WriteMat(std::ostream& out, const FloatMap& map) {
+  CHECK(!map.Empty());
+  out << map.Width() << "&" << map.Height() << "&" << map.Channels() << "&";
+  out.write(reinterpret_cast<const char*>(map.Data().data()),
+            static_cast<std::streamsize>(map.Data().size() * sizeof(float)));
+}
+
+void WriteMat(const std::string& path, const FloatMap& map) {
+  WriteFileAtomically(path, [&map](std::ostream& out) { WriteMat(out, map); });
+}
+
+}  // namespace hairmvs

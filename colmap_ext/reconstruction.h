@@ -1,0 +1,121 @@
+#pragma once
+// COLMAP's sparse model (cameras, images, points3D), read and written in COLMAP's binary and
+// text formats (../shared/design/colmap-formats.md section 4). Records are kept sorted by id;
+// `image_order` keeps the order of the records in the files as read, which is COLMAP 3.8's
+// image index (image_idx) for .vis files and consistency graphs.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <cstdint>
+#include <istream>
+#include <limits>
+#include <map>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace hairmvs {
+
+constexpr uint64_t kInvalidPoint3DId = std::numeric_limits<uint64_t>::max();
+
+// COLMAP's camera models by id (0-10: COLMAP 3.8; 11-17: later releases).
+struct CameraModelInfo {
+  int id;
+  const char* name;
+  int num_params;
+};
+const std::vector<CameraModelInfo>& CameraModels();
+// Throws hairmvs::Error for an unknown id / name.
+const CameraModelInfo& CameraModelById(int model_id);
+const CameraModelInfo& CameraModelByName(const std::string& name);
+
+struct Camera {
+  uint32_t camera_id = 0;
+  int model_id = 1;  // PINHOLE
+  uint64_t width = 0;
+  uint64_t height = 0;
+  std::vector<double> params;
+
+  std::string ModelName() const;
+  bool IsPinhole() const;  // PINHOLE or SIMPLE_PINHOLE: what stereo needs
+  // K for PINHOLE / SIMPLE_PINHOLE. Throws hairmvs::Error for any other model, telling the
+  // user to run `colmap image_undistorter`.
+  Eigen::Matrix3d CalibrationMatrix() const;
+};
+
+struct Point2D {
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();  // SfM pixel convention (centre of pixel 0 at 0.5)
+  uint64_t point3D_id = kInvalidPoint3DId;
+};
+
+struct Image {
+  uint32_t image_id = 0;
+  uint32_t camera_id = 0;
+  std::string name;
+  // cam_from_world: X_cam = R * X_world + t. Quaternion is Hamilton, stored (w, x, y, z) in files.
+  Eigen::Quaterniond cam_from_world_rotation = Eigen::Quaterniond::Identity();
+  Eigen::Vector3d cam_from_world_translation = Eigen::Vector3d::Zero();
+  std::vector<Point2D> points2D;
+
+  Eigen::Matrix3d R() const { return cam_from_world_rotation.toRotationMatrix(); }
+  const Eigen::Vector3d& t() const { return cam_from_world_translation; }
+  Eigen::Vector3d ProjectionCenter() const { return -(R().transpose() * t()); }
+  // Unit viewing direction (camera +z) in world coordinates.
+  Eigen::Vector3d ViewingDirection() const { return R().row(2).transpose(); }
+};
+
+struct TrackElement {
+  uint32_t image_id = 0;
+  uint32_t point2D_idx = 0;
+};
+
+struct Point3D {
+  uint64_t point3D_id = 0;
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  uint8_t rgb[3] = {0, 0, 0};
+  double error = -1.0;
+  std::vector<TrackElement> track;
+};
+
+struct Reconstruction {
+  std::map<uint32_t, Camera> cameras;
+  std::map<uint32_t, Image> images;
+  std::map<uint64_t, Point3D> points3D;
+  // Image ids in the order of the records of images.bin / images.txt as read (COLMAP 3.8's
+  // image_idx). Models built in memory or written by us use ascending ids.
+  std::vector<uint32_t> image_order;
+
+  const Image& ImageByName(const std::string& name) const;  // throws hairmvs::Error
+  const Image* FindImageByName(const std::string& name) const;
+  // Fills image_order with ascending ids (what our writers write).
+  void SortImageOrder();
+};
+
+enum class ModelFormat { kBinary, kText };
+
+// Reads `dir`: binary when cameras.bin, images.bin and points3D.bin all exist, else text
+// (COLMAP's rule). Accepts and ignores rigs.* / frames.* (COLMAP 3.12+). Throws hairmvs::Error
+// naming the file and the problem (missing, truncated, trailing bytes, unknown model id,
+// wrong parameter count, malformed line).
+Reconstruction ReadReconstruction(const std::string& dir);
+// Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, each file
+// atomically (temporary name, then rename).
+void WriteReconstruction(const Reconstruction& reconstruction, const std::string& dir,
+                         ModelFormat format);
+
+// Stream versions, for tests that round-trip through memory. `source` names the stream in
+// error messages.
+void ReadCamerasBinary(std::istream& in, const std::string& source, Reconstruction* r);
+void ReadImagesBinary(std::istream& in, const std::string& source, Reconstruction* r);
+void ReadPoints3DBinary(std::istream& in, const std::string& source, Reconstruction* r);
+void ReadCamerasText(std::istream& in, const std::string& source, Reconstruction* r);
+void ReadImagesText(std::istream& in, const std::string& source, Reconstruction* r);
+void ReadPoints3DText(std::istream& in, const std::string& source, Reconstruction* r);
+void WriteCamerasBinary(const Reconstruction& r, std::ostream& out);
+void WriteImagesBinary(const Reconstruction& r, std::ostream& out);
+void WritePoints3DBinary(const Reconstruction& r, std::ostream& out);
+void WriteCamerasText(const Reconstruction& r, std::ostream& out);
+void WriteImagesText(const Reconstruction& r, std::ostream& out);
+void WritePoints3DText(const Reconstruction& r, std::ostream& out);
+
+}  // namespace hairmvs

@@ -1,0 +1,57 @@
+#pragma once
+// A COLMAP dense workspace as `colmap image_undistorter --output_type COLMAP` writes it:
+// images/, sparse/ (bin or txt), stereo/ (patch-match.cfg, fusion.cfg, depth_maps/,
+// normal_maps/), optional masks (<mask_path>/<image name>.png, 0 = excluded).
+// hairmvs adds stereo/orientation_maps/ and stereo/confidence_maps/ in the same naming.
+
+#include <string>
+#include <vector>
+
+#include "colmap_ext/reconstruction.h"
+#include "src/core/float_map.h"
+
+namespace hairmvs {
+
+class Workspace {
+ public:
+  // Reads the model of `path`/sparse and checks that every image of the model exists under
+  // images/. `mask_path` empty: `path`/masks if that folder exists, else no masks.
+  // Throws hairmvs::Error naming the file and the problem.
+  static Workspace Read(const std::string& path, const std::string& mask_path = "");
+
+  const std::string& Path() const { return path_; }
+  const Reconstruction& Model() const { return model_; }
+  // Image names in COLMAP's image_idx order (the order of the records in sparse/images.*).
+  const std::vector<std::string>& ImageNames() const { return image_names_; }
+  int ImageIdx(const std::string& name) const;  // throws for an unknown name
+  const Image& ImageByName(const std::string& name) const;
+  // Throws (telling the user to run colmap image_undistorter) unless PINHOLE/SIMPLE_PINHOLE.
+  const Camera& CameraOf(const std::string& name) const;
+
+  std::string ImagePath(const std::string& name) const;
+  // "" when the workspace has no masks or this image has none.
+  std::string MaskPath(const std::string& name) const;
+  std::string StereoPath() const;
+  // type: "geometric" or "photometric".
+  std::string DepthMapPath(const std::string& name, const std::string& type = "geometric") const;
+  std::string NormalMapPath(const std::string& name, const std::string& type = "geometric") const;
+  std::string ConfidenceMapPath(const std::string& name) const;
+  std::string OrientationMapPath(const std::string& name, int level) const;
+
+ private:
+  std::string path_;
+  std::string mask_path_;
+  Reconstruction model_;
+  std::vector<std::string> image_names_;
+};
+
+// Images as float maps, for the dense stages. Throws hairmvs::Error naming the file.
+// Grey in [0, 1] (BT.601 luma of 8- or 16-bit images).
+FloatMap ReadImageGray(const std::string& path);
+// RGB in [0, 1], 3 channels (R, G, B planes).
+FloatMap ReadImageRgb(const std::string& path);
+// A mask resized to width x height (nearest); 1 = keep, 0 = excluded. An all-zero mask is an
+// error naming the file. Returns a map of ones if `path` is empty.
+FloatMap ReadMask(const std::string& path, int width, int height);
+
+}  // namespace hairmvs

@@ -1,0 +1,143 @@
+#include "src/core/file_util.h"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "src/core/logging.h"
+
+namespace fs = std::filesystem;
+
+namespace hairmvs {
+
+std::string JoinPaths(const std::string& a, const std::string& b) {
+  if (a.empty()) return b;
+  if (b.empty()) return a;
+  return (fs::path(a) / fs::path(b)).string();
+}
+
+bool ExistsFile(const std::string& path) {
+  std::error_code ec;
+  return fs::is_regular_file(path, ec);
+}
+
+bool ExistsDir(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec);
+}
+
+void RequireFile(const std::string& path, const std::string& what) {
+  THROW_IF(!ExistsFile(path), "Missing " << what << ": " << path);
+}
+
+void RequireDir(const std::string& path, const std::string& what) {
+  THROW_IF(!ExistsDir(path), "Missing " << what << ": " << path);
+}
+
+void CreateDirs(const std::string& path) {
+  if (path.empty()) return;
+  std::error_code ec;
+  fs::create_directories(path, ec);
+  THROW_IF(ec && !ExistsDir(path), "Cannot create folder " << path << ": " << ec.message());
+}
+
+std::string ParentPath(const std::string& path) { return fs::path(path).parent_path().string(); }
+
+std::string ReadTextFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  THROW_IF(!in, "Cannot open " << path);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> ReadLines(const std::string& path) {
+  std::istringstream in(ReadTextFile(path));
+  std::vector<std::string> lines;
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(line);
+  }
+  return lines;
+}
+
+std::string StripWhitespace(const std::string& s) {
+  const char* ws = " \t\r\n\v\f";
+  const size_t begin = s.find_first_not_of(ws);
+  if (begin == std::string::npos) return "";
+  const size_t end = s.find_last_not_of(ws);
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> SplitString(const std::string& s, const std::string& delims) {
+  std::vector<std::string> parts;
+  size_t start = 0;
+  while (true) {
+    const size_t pos = s.find_first_of(delims, start);
+    parts.push_back(s.substr(start, pos == std::string::npos ? std::string::npos : pos - start));
+    if (pos == std::string::npos) break;
+    start = pos + 1;
+  }
+  return parts;
+}
+
+namespace {
+
+std::string TemporaryPathFor(const std::string& path) {
+  static std::atomic<int> counter{0};
+  const fs::path p(path);
+  std::ostringstream name;
+  name << "." << p.stem().string() << ".tmp" << getpid() << "_" << counter++
+       << p.extension().string();
+  return (p.parent_path() / name.str()).string();
+}
+
+void RenameOver(const std::string& tmp, const std::string& path) {
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    HAIRMVS_THROW("Cannot rename " << tmp << " to " << path);
+  }
+}
+
+}  // namespace
+
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write, bool binary) {
+  CreateDirs(ParentPath(path));
+  const std::string tmp = TemporaryPathFor(path);
+  try {
+    std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
+    THROW_IF(!out, "Cannot write " << path << " (temporary " << tmp << ")");
+    write(out);
+    out.flush();
+    THROW_IF(!out, "Write failed for " << path << " (disk full?)");
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  RenameOver(tmp, path);
+}
+
+void WritePathAtomically(const std::string& path,
+                         const std::function<void(const std::string& tmp_path)>& write) {
+  CreateDirs(ParentPath(path));
+  const std::string tmp = TemporaryPathFor(path);
+  try {
+    write(tmp);
+    THROW_IF(!ExistsFile(tmp), "Write failed for " << path);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  RenameOver(tmp, path);
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,42 @@
+#pragma once
+// Files: paths, existence checks that throw with the path, and atomic writes.
+// Nothing is lost: every output is written under a temporary name in the same folder and
+// renamed over the target only once complete, so an existing file is never half-overwritten.
+
+#include <functional>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace hairmvs {
+
+std::string JoinPaths(const std::string& a, const std::string& b);
+template <typename... T>
+std::string JoinPaths(const std::string& a, const std::string& b, const T&... rest) {
+  return JoinPaths(JoinPaths(a, b), rest...);
+}
+
+bool ExistsFile(const std::string& path);
+bool ExistsDir(const std::string& path);
+// Throws hairmvs::Error naming `what` and `path` when missing.
+void RequireFile(const std::string& path, const std::string& what = "file");
+void RequireDir(const std::string& path, const std::string& what = "folder");
+// Creates the folder and its parents (no error if it exists).
+void CreateDirs(const std::string& path);
+std::string ParentPath(const std::string& path);
+std::string ReadTextFile(const std::string& path);
+std::vector<std::string> ReadLines(const std::string& path);
+std::string StripWhitespace(const std::string& s);
+std::vector<std::string> SplitString(const std::string& s, const std::string& delims);
+
+// Writes `path` atomically: `write` fills a stream for a temporary file next to `path`,
+// which is then renamed to `path`. Parent folders are created. If `write` throws, the
+// temporary file is removed and the exception propagates; `path` is untouched.
+void WriteFileAtomically(const std::string& path,
+                         const std::function<void(std::ostream&)>& write, bool binary = true);
+// For writers that need a file name (OpenCV's imwrite): `write` receives a temporary path
+// with the same extension as `path`.
+void WritePathAtomically(const std::string& path,
+                         const std::function<void(const std::string& tmp_path)>& write);
+
+}  // namespace hairmvs

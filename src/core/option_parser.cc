@@ -1,0 +1,164 @@
+#include "src/core/option_parser.h"
+
+#include <boost/program_options.hpp>
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace po = boost::program_options;
+
+namespace hairmvs {
+
+struct OptionParser::Impl {
+  std::string command;
+  std::string description;
+  po::options_description desc{"Options"};
+  po::variables_map vm;
+  std::vector<std::string> names;
+  std::map<std::string, std::function<std::string()>> printers;
+  std::map<std::string, std::function<bool(const std::string&)>> converters;
+  std::map<std::string, std::string> converter_text;
+  std::map<std::string, std::string> ignored;
+};
+
+OptionParser::OptionParser(std::string command, std::string description)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->command = std::move(command);
+  impl_->description = std::move(description);
+  impl_->desc.add_options()("help,h", "print this help");
+}
+
+OptionParser::~OptionParser() = default;
+
+namespace {
+
+template <typename T>
+std::string ToText(const T& value) {
+  std::ostringstream ss;
+  ss << value;
+  return ss.str();
+}
+
+std::string JoinNames(const std::vector<std::string>& values) {
+  std::string out;
+  for (size_t i = 0; i < values.size(); ++i) out += (i ? "," : "") + values[i];
+  return out;
+}
+
+}  // namespace
+
+#define HAIRMVS_ADD_TYPED_OPTION(TYPE)                                                      \
+  void OptionParser::Add(const std::string& name, TYPE* value, const std::string& help,   \
+                         bool required) {                                                  \
+    auto* semantic = po::value<TYPE>(value);                                               \
+    if (required) semantic->required();                                                    \
+    else semantic->default_value(*value, ToText(*value));                                  \
+    impl_->desc.add_options()(name.c_str(), semantic, help.c_str());                       \
+    impl_->names.push_back(name);                                                          \
+    impl_->printers[name] = [value] { return ToText(*value); };                            \
+  }
+
+HAIRMVS_ADD_TYPED_OPTION(int)
+HAIRMVS_ADD_TYPED_OPTION(long)
+HAIRMVS_ADD_TYPED_OPTION(double)
+HAIRMVS_ADD_TYPED_OPTION(float)
+HAIRMVS_ADD_TYPED_OPTION(std::string)
+#undef HAIRMVS_ADD_TYPED_OPTION
+
+void OptionParser::Add(const std::string& name, bool* value, const std::string& help,
+                       bool required) {
+  AddConverted(
+      name, *value ? "1" : "0", help, required,
+      [value](const std::string& text) {
+        if (text == "1" || text == "true" || text == "on" || text == "yes") *value = true;
+        else if (text == "0" || text == "false" || text == "off" || text == "no") *value = false;
+        else return false;
+        return true;
+      },
+      [value] { return std::string(*value ? "1" : "0"); });
+}
+
+void OptionParser::Add(const std::string& name, std::vector<std::string>* value,
+                       const std::string& help, bool required) {
+  AddConverted(
+      name, JoinNames(*value), help, required,
+      [value](const std::string& text) {
+        value->clear();
+        for (const std::string& part : SplitString(text, ",;")) {
+          const std::string item = StripWhitespace(part);
+          if (!item.empty()) value->push_back(item);
+        }
+        return true;
+      },
+      [value] { return JoinNames(*value); });
+}
+
+void OptionParser::AddConverted(const std::string& name, const std::string& default_text,
+                                const std::string& help, bool required,
+                                std::function<bool(const std::string&)> parse,
+                                std::function<std::string()> print) {
+  auto* semantic = po::value<std::string>();
+  if (required) semantic->required();
+  else semantic->default_value(default_text);
+  impl_->desc.add_options()(name.c_str(), semantic, help.c_str());
+  impl_->names.push_back(name);
+  impl_->printers[name] = std::move(print);
+  impl_->converters[name] = std::move(parse);
+  impl_->converter_text[name] = default_text;
+}
+
+void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
+  impl_->desc.add_options()(name.c_str(), po::value<std::string>(),
+                            ("accepted for compatibility, ignored: " + why).c_str());
+  impl_->ignored[name] = why;
+}
+
+bool OptionParser::Parse(int argc, char** argv, int first) {
+  std::vector<std::string> args(argv + first, argv + argc);
+  try {
+    po::store(po::command_line_parser(args).options(impl_->desc).run(), impl_->vm);
+    if (impl_->vm.count("help")) {
+      std::cout << Help();
+      return false;
+    }
+    po::notify(impl_->vm);
+  } catch (const po::error& e) {
+    HAIRMVS_THROW("hairmvs " << impl_->command << ": " << e.what()
+                              << " (see hairmvs " << impl_->command << " -h)");
+  }
+  for (auto& [name, parse] : impl_->converters) {
+    if (!impl_->vm.count(name) || impl_->vm[name].defaulted()) continue;
+    const std::string text = impl_->vm[name].as<std::string>();
+    THROW_IF(!parse(text), "hairmvs " << impl_->command << ": invalid value '" << text
+                                      << "' for --" << name);
+  }
+  for (const auto& [name, why] : impl_->ignored) {
+    if (impl_->vm.count(name)) {
+      LOG(WARNING) << "--" << name << " is ignored by hairmvs: " << why;
+    }
+  }
+  return true;
+}
+
+bool OptionParser::WasGiven(const std::string& name) const {
+  return impl_->vm.count(name) && !impl_->vm[name].defaulted();
+}
+
+std::string OptionParser::Help() const {
+  std::ostringstream out;
+  out << "hairmvs " << impl_->command << ": " << impl_->description << "\n\n" << impl_->desc;
+  return out.str();
+}
+
+std::string OptionParser::Values() const {
+  std::ostringstream out;
+  for (const std::string& name : impl_->names) {
+    out << "  " << name << " = " << impl_->printers.at(name)() << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace hairmvs

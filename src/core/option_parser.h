@@ -1,0 +1,82 @@
+#pragma once
+// Command-line options in COLMAP's style: `hairmvs <command> --workspace_path W
+// --Section.option value`, `-h` per command. Each *Options struct keeps the one list of its
+// fields in a ForEachField(visitor) member; the CLI, the help text and the printout of the
+// values in use all derive from it:
+//
+//   struct FooOptions {
+//     double lambda = 0.5;  // why this default
+//     template <typename Visitor> void ForEachField(Visitor&& v) {
+//       v("lambda", &lambda, "smoothness weight (paper Eq. 3)");
+//     }
+//     bool Check(std::string* error) const;
+//   };
+//   OptionParser parser("orientation_stereo", "...");
+//   parser.AddSection("OrientationStereo", &foo_options);
+//
+// Supported field types: bool (0/1/true/false), int, int64, double, float, std::string,
+// std::vector<std::string> (comma-separated), and enum classes that provide
+// `std::string ToString(E)` and `bool FromString(const std::string&, E*)` found by ADL.
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace hairmvs {
+
+class OptionParser {
+ public:
+  OptionParser(std::string command, std::string description);
+  ~OptionParser();
+
+  void Add(const std::string& name, bool* value, const std::string& help, bool required = false);
+  void Add(const std::string& name, int* value, const std::string& help, bool required = false);
+  void Add(const std::string& name, long* value, const std::string& help, bool required = false);
+  void Add(const std::string& name, double* value, const std::string& help, bool required = false);
+  void Add(const std::string& name, float* value, const std::string& help, bool required = false);
+  void Add(const std::string& name, std::string* value, const std::string& help,
+           bool required = false);
+  void Add(const std::string& name, std::vector<std::string>* value, const std::string& help,
+           bool required = false);
+
+  template <typename E, typename = std::enable_if_t<std::is_enum_v<E>>>
+  void Add(const std::string& name, E* value, const std::string& help, bool required = false) {
+    AddConverted(
+        name, ToString(*value), help, required,
+        [value](const std::string& text) { return FromString(text, value); },
+        [value] { return ToString(*value); });
+  }
+
+  // Adds every field of an options struct as `--Section.field`.
+  template <typename OptionsT>
+  void AddSection(const std::string& section, OptionsT* options) {
+    options->ForEachField([this, &section](const char* field, auto* ptr, const char* help) {
+      Add(section + "." + field, ptr, help);
+    });
+  }
+
+  // An option accepted for compatibility (e.g. one of colmap patch_match_stereo's) but
+  // without effect here: if given, a warning says it is ignored and why.
+  void AddIgnored(const std::string& name, const std::string& why);
+
+  // Parses argv[first..argc). Returns false when help was requested (and printed).
+  // Throws hairmvs::Error on an unknown option, a missing value or a bad value.
+  bool Parse(int argc, char** argv, int first = 2);
+  bool WasGiven(const std::string& name) const;
+  std::string Help() const;
+  // "name = value" lines for the values in use, for logs.
+  std::string Values() const;
+
+ private:
+  void AddConverted(const std::string& name, const std::string& default_text,
+                    const std::string& help, bool required,
+                    std::function<bool(const std::string&)> parse,
+                    std::function<std::string()> print);
+
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace hairmvs

@@ -1,0 +1,85 @@
+#include "src/core/option_parser.h"
+
+#include <gtest/gtest.h>
+
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+enum class Solver { kGraphCuts, kSemiGlobal };
+std::string ToString(Solver s) { return s == Solver::kGraphCuts ? "graph_cuts" : "semi_global"; }
+bool FromString(const std::string& text, Solver* s) {
+  if (text == "graph_cuts") *s = Solver::kGraphCuts;
+  else if (text == "semi_global") *s = Solver::kSemiGlobal;
+  else return false;
+  return true;
+}
+
+struct ToyOptions {
+  double lambda = 0.5;
+  int num_levels = 3;
+  bool write_png = false;
+  Solver solver = Solver::kGraphCuts;
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("lambda", &lambda, "smoothness weight");
+    v("num_levels", &num_levels, "levels");
+    v("write_png", &write_png, "pictures");
+    v("solver", &solver, "graph_cuts|semi_global");
+  }
+};
+
+std::vector<char*> Argv(std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  return argv;
+}
+
+TEST(OptionParser, ParsesSectionsInColmapStyle) {
+  ToyOptions options;
+  std::string workspace;
+  OptionParser parser("toy", "a toy command");
+  parser.Add("workspace_path", &workspace, "workspace", /*required=*/true);
+  parser.AddSection("Toy", &options);
+  std::vector<std::string> args = {"hairmvs", "toy", "--workspace_path", "/w",
+                                   "--Toy.lambda", "2.5", "--Toy.write_png", "1",
+                                   "--Toy.solver", "semi_global"};
+  auto argv = Argv(args);
+  ASSERT_TRUE(parser.Parse(static_cast<int>(argv.size()), argv.data()));
+  EXPECT_EQ(workspace, "/w");
+  EXPECT_DOUBLE_EQ(options.lambda, 2.5);
+  EXPECT_EQ(options.num_levels, 3);
+  EXPECT_TRUE(options.write_png);
+  EXPECT_EQ(options.solver, Solver::kSemiGlobal);
+  EXPECT_TRUE(parser.WasGiven("Toy.lambda"));
+  EXPECT_FALSE(parser.WasGiven("Toy.num_levels"));
+  EXPECT_NE(parser.Values().find("Toy.solver = semi_global"), std::string::npos);
+}
+
+TEST(OptionParser, RejectsUnknownOptionsAndBadValues) {
+  ToyOptions options;
+  OptionParser parser("toy", "a toy command");
+  parser.AddSection("Toy", &options);
+  std::vector<std::string> unknown = {"hairmvs", "toy", "--Toy.nope", "1"};
+  auto argv = Argv(unknown);
+  EXPECT_THROW(parser.Parse(static_cast<int>(argv.size()), argv.data()), Error);
+
+  OptionParser parser2("toy", "a toy command");
+  parser2.AddSection("Toy", &options);
+  std::vector<std::string> bad = {"hairmvs", "toy", "--Toy.solver", "simulated_annealing"};
+  auto argv2 = Argv(bad);
+  EXPECT_THROW(parser2.Parse(static_cast<int>(argv2.size()), argv2.data()), Error);
+}
+
+TEST(OptionParser, MissingRequiredOptionIsAnError) {
+  std::string workspace;
+  OptionParser parser("toy", "a toy command");
+  parser.Add("workspace_path", &workspace, "workspace", /*required=*/true);
+  std::vector<std::string> args = {"hairmvs", "toy"};
+  auto argv = Argv(args);
+  EXPECT_THROW(parser.Parse(static_cast<int>(argv.size()), argv.data()), Error);
+}
+
+}  // namespace
+}  // namespace hairmvs
