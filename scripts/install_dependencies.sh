@@ -12,7 +12,7 @@ PACKAGES=(
   libmaxflow-dev
   libcgal-dev libgmp-dev libmpfr-dev
   libboost-program-options-dev libboost-filesystem-dev
-  nlohmann-json3-dev libzip-dev
+  nlohmann-json3-dev libzip-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 
