@@ -13,6 +13,7 @@ PACKAGES=(
   libcgal-dev libgmp-dev libmpfr-dev
   libboost-program-options-dev libboost-filesystem-dev
   nlohmann-json3-dev libzip-dev libnanoflann-dev
+  libopen3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
 
