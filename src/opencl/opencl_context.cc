@@ -1,0 +1,283 @@
+#include "src/opencl/opencl_context.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include "kernels/embedded_kernels.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+std::string ToLower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
+}
+
+std::string DeviceTypeName(cl_device_type type) {
+  if (type & CL_DEVICE_TYPE_GPU) return "GPU";
+  if (type & CL_DEVICE_TYPE_CPU) return "CPU";
+  if (type & CL_DEVICE_TYPE_ACCELERATOR) return "ACCELERATOR";
+  return "OTHER";
+}
+
+// Platform/device pairs in a fixed order: platforms as the ICD loader lists them, devices as
+// each platform lists them. Throws when no platform exists.
+std::vector<std::pair<cl::Platform, cl::Device>> AllDevices() {
+  std::vector<cl::Platform> platforms;
+  cl_int err = CL_SUCCESS;
+  try {
+    err = cl::Platform::get(&platforms);
+  } catch (const cl::Error& e) {
+    err = e.err();
+  }
+  THROW_IF(err != CL_SUCCESS || platforms.empty(),
+           "No OpenCL platform found (" << OpenCLErrorString(err)
+                                        << "). Install an OpenCL driver, e.g. the Debian package "
+                                           "pocl-opencl-icd (a CPU implementation), and check "
+                                           "that /etc/OpenCL/vendors/ lists an .icd file.");
+  std::vector<std::pair<cl::Platform, cl::Device>> result;
+  for (auto& platform : platforms) {
+    std::vector<cl::Device> devices;
+    try {
+      platform.getDevices(CL_DEVICE_TYPE_ALL, &devices);
+    } catch (const cl::Error&) {
+      continue;  // CL_DEVICE_NOT_FOUND: a platform without devices.
+    }
+    for (auto& device : devices) result.emplace_back(platform, device);
+  }
+  THROW_IF(result.empty(), "OpenCL platforms exist but expose no device. Install an OpenCL "
+                           "driver, e.g. the Debian package pocl-opencl-icd.");
+  return result;
+}
+
+OpenCLDeviceInfo DescribeDevice(int index, const cl::Platform& platform, const cl::Device& device) {
+  OpenCLDeviceInfo info;
+  info.index = index;
+  info.platform_name = StripWhitespace(platform.getInfo<CL_PLATFORM_NAME>());
+  info.device_name = StripWhitespace(device.getInfo<CL_DEVICE_NAME>());
+  info.type = DeviceTypeName(device.getInfo<CL_DEVICE_TYPE>());
+  info.compute_units = static_cast<int>(device.getInfo<CL_DEVICE_MAX_COMPUTE_UNITS>());
+  info.global_memory_mib = device.getInfo<CL_DEVICE_GLOBAL_MEM_SIZE>() / (1024.0 * 1024.0);
+  info.max_alloc_mib = device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>() / (1024.0 * 1024.0);
+  info.local_memory_kib = device.getInfo<CL_DEVICE_LOCAL_MEM_SIZE>() / 1024.0;
+  info.max_work_group_size = device.getInfo<CL_DEVICE_MAX_WORK_GROUP_SIZE>();
+  info.opencl_c_version = StripWhitespace(device.getInfo<CL_DEVICE_OPENCL_C_VERSION>());
+  info.device_version = StripWhitespace(device.getInfo<CL_DEVICE_VERSION>());
+  return info;
+}
+
+bool IsNumber(const std::string& s) {
+  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+}
+
+void ResolveIncludesInText(const std::string& file, const std::string& text,
+                           std::set<std::string>* included, std::ostream& out);
+
+void ResolveIncludes(const std::string& file, std::set<std::string>* included, std::ostream& out) {
+  const auto& sources = EmbeddedKernelSources();
+  const auto it = sources.find(file);
+  if (it == sources.end()) {
+    std::ostringstream known;
+    for (const auto& [name, text] : sources) known << " " << name;
+    HAIRMVS_THROW("Unknown OpenCL kernel file '" << file << "' (embedded kernels:" << known.str()
+                                                 << ")");
+  }
+  if (!included->insert(file).second) return;
+  ResolveIncludesInText(file, it->second, included, out);
+}
+
+void ResolveIncludesInText(const std::string& file, const std::string& text,
+                           std::set<std::string>* included, std::ostream& out) {
+  std::istringstream in(text);
+  std::string line;
+  int line_number = 0;
+  out << "#line 1 \"" << file << "\"\n";
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string stripped = StripWhitespace(line);
+    if (stripped.rfind("#include", 0) == 0) {
+      const size_t open = stripped.find('"');
+      const size_t close = stripped.rfind('"');
+      THROW_IF(open == std::string::npos || close <= open,
+               "Kernel file '" << file << "' line " << line_number
+                               << ": only #include \"name.clh\" is supported, got: " << stripped);
+      ResolveIncludes(stripped.substr(open + 1, close - open - 1), included, out);
+      out << "#line " << line_number + 1 << " \"" << file << "\"\n";
+      continue;
+    }
+    out << line << "\n";
+  }
+}
+
+}  // namespace
+
+std::string OpenCLErrorString(cl_int code) {
+  const char* name = "unknown error";
+  switch (code) {
+    case CL_SUCCESS: name = "CL_SUCCESS"; break;
+    case CL_DEVICE_NOT_FOUND: name = "CL_DEVICE_NOT_FOUND"; break;
+    case CL_DEVICE_NOT_AVAILABLE: name = "CL_DEVICE_NOT_AVAILABLE"; break;
+    case CL_COMPILER_NOT_AVAILABLE: name = "CL_COMPILER_NOT_AVAILABLE"; break;
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE: name = "CL_MEM_OBJECT_ALLOCATION_FAILURE"; break;
+    case CL_OUT_OF_RESOURCES: name = "CL_OUT_OF_RESOURCES"; break;
+    case CL_OUT_OF_HOST_MEMORY: name = "CL_OUT_OF_HOST_MEMORY"; break;
+    case CL_BUILD_PROGRAM_FAILURE: name = "CL_BUILD_PROGRAM_FAILURE"; break;
+    case CL_INVALID_VALUE: name = "CL_INVALID_VALUE"; break;
+    case CL_INVALID_PLATFORM: name = "CL_INVALID_PLATFORM"; break;
+    case CL_INVALID_DEVICE: name = "CL_INVALID_DEVICE"; break;
+    case CL_INVALID_CONTEXT: name = "CL_INVALID_CONTEXT"; break;
+    case CL_INVALID_COMMAND_QUEUE: name = "CL_INVALID_COMMAND_QUEUE"; break;
+    case CL_INVALID_MEM_OBJECT: name = "CL_INVALID_MEM_OBJECT"; break;
+    case CL_INVALID_BUILD_OPTIONS: name = "CL_INVALID_BUILD_OPTIONS"; break;
+    case CL_INVALID_PROGRAM: name = "CL_INVALID_PROGRAM"; break;
+    case CL_INVALID_KERNEL_NAME: name = "CL_INVALID_KERNEL_NAME"; break;
+    case CL_INVALID_KERNEL_ARGS: name = "CL_INVALID_KERNEL_ARGS"; break;
+    case CL_INVALID_ARG_INDEX: name = "CL_INVALID_ARG_INDEX"; break;
+    case CL_INVALID_ARG_VALUE: name = "CL_INVALID_ARG_VALUE"; break;
+    case CL_INVALID_ARG_SIZE: name = "CL_INVALID_ARG_SIZE"; break;
+    case CL_INVALID_WORK_DIMENSION: name = "CL_INVALID_WORK_DIMENSION"; break;
+    case CL_INVALID_WORK_GROUP_SIZE: name = "CL_INVALID_WORK_GROUP_SIZE"; break;
+    case CL_INVALID_WORK_ITEM_SIZE: name = "CL_INVALID_WORK_ITEM_SIZE"; break;
+    case CL_INVALID_GLOBAL_WORK_SIZE: name = "CL_INVALID_GLOBAL_WORK_SIZE"; break;
+    case CL_INVALID_BUFFER_SIZE: name = "CL_INVALID_BUFFER_SIZE"; break;
+    case -1001: name = "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL driver installed)"; break;
+    default: break;
+  }
+  return std::string(name) + " (" + std::to_string(code) + ")";
+}
+
+std::vector<OpenCLDeviceInfo> ListOpenCLDevices() {
+  std::vector<OpenCLDeviceInfo> infos;
+  const auto devices = AllDevices();
+  for (size_t i = 0; i < devices.size(); ++i) {
+    infos.push_back(DescribeDevice(static_cast<int>(i), devices[i].first, devices[i].second));
+  }
+  return infos;
+}
+
+std::string OpenCLDevicesTable(const std::vector<OpenCLDeviceInfo>& devices) {
+  std::ostringstream out;
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-5s %-11s %-6s %10s %10s %9s %-22s %s\n", "index", "type",
+                "CUs", "mem MiB", "alloc MiB", "local KiB", "OpenCL C", "platform / device");
+  out << line;
+  for (const auto& d : devices) {
+    std::snprintf(line, sizeof(line), "%-5d %-11s %-6d %10.0f %10.0f %9.0f %-22s %s / %s\n",
+                  d.index, d.type.c_str(), d.compute_units, d.global_memory_mib, d.max_alloc_mib,
+                  d.local_memory_kib, d.opencl_c_version.c_str(), d.platform_name.c_str(),
+                  d.device_name.c_str());
+    out << line;
+  }
+  return out.str();
+}
+
+std::shared_ptr<OpenCLContext> OpenCLContext::Create(const std::string& device_spec) {
+  const auto devices = AllDevices();
+  const std::string spec = StripWhitespace(device_spec);
+  int chosen = -1;
+  if (spec.empty()) {
+    for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
+      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) chosen = static_cast<int>(i);
+    }
+    for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
+      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) chosen = static_cast<int>(i);
+    }
+    if (chosen < 0) chosen = 0;
+  } else if (IsNumber(spec)) {
+    const long index = std::stol(spec);
+    THROW_IF(index >= static_cast<long>(devices.size()),
+             "--OpenCL.device " << spec << ": no such device index; there are " << devices.size()
+                                << " device(s):\n"
+                                << OpenCLDevicesTable(ListOpenCLDevices()));
+    chosen = static_cast<int>(index);
+  } else {
+    const std::string needle = ToLower(spec);
+    for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
+      const std::string name = ToLower(StripWhitespace(devices[i].first.getInfo<CL_PLATFORM_NAME>()) +
+                                       " / " +
+                                       StripWhitespace(devices[i].second.getInfo<CL_DEVICE_NAME>()));
+      if (name.find(needle) != std::string::npos) chosen = static_cast<int>(i);
+    }
+    THROW_IF(chosen < 0, "--OpenCL.device '" << spec
+                                             << "': no device index or name matches; devices:\n"
+                                             << OpenCLDevicesTable(ListOpenCLDevices()));
+  }
+
+  std::shared_ptr<OpenCLContext> ctx(new OpenCLContext());
+  const auto& [platform, device] = devices[chosen];
+  ctx->device_ = device;
+  ctx->platform_name_ = StripWhitespace(platform.getInfo<CL_PLATFORM_NAME>());
+  ctx->device_name_ = StripWhitespace(device.getInfo<CL_DEVICE_NAME>());
+  ctx->is_cpu_ = (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  try {
+    ctx->context_ = cl::Context(device);
+    ctx->queue_ = cl::CommandQueue(ctx->context_, device);  // in-order, no profiling
+  } catch (const cl::Error& e) {
+    HAIRMVS_THROW("Could not create an OpenCL context on '" << ctx->device_name_ << "': "
+                                                             << e.what() << " "
+                                                             << OpenCLErrorString(e.err()));
+  }
+  return ctx;
+}
+
+std::string ResolveKernelSource(const std::string& file) {
+  std::set<std::string> included;
+  std::ostringstream out;
+  ResolveIncludes(file, &included, out);
+  return out.str();
+}
+
+cl::Program& OpenCLContext::Program(const std::vector<std::string>& kernel_files,
+                                    const std::string& build_options) {
+  CHECK(!kernel_files.empty());
+  std::set<std::string> included;
+  std::ostringstream source;
+  for (const auto& file : kernel_files) ResolveIncludes(file, &included, source);
+  return BuildProgram(source.str(), build_options);
+}
+
+cl::Program& OpenCLContext::ProgramFromSource(const std::string& text,
+                                              const std::string& build_options) {
+  std::set<std::string> included;
+  std::ostringstream resolved;
+  ResolveIncludesInText("<source>", text, &included, resolved);
+  return BuildProgram(resolved.str(), build_options);
+}
+
+cl::Program& OpenCLContext::BuildProgram(const std::string& source,
+                                         const std::string& build_options) {
+  std::lock_guard<std::mutex> lock(program_mutex_);
+  const std::string key = source + "\n//options: " + build_options;
+  const auto it = programs_.find(key);
+  if (it != programs_.end()) return it->second;
+
+  cl::Program program(context_, source);
+  // -cl-std=CL1.2: the kernels are OpenCL C 1.2 whatever the device's newest version.
+  const std::string options = "-cl-std=CL1.2 " + build_options;
+  try {
+    program.build(std::vector<cl::Device>{device_}, options.c_str());
+  } catch (const cl::Error& e) {
+    std::string log;
+    try {
+      log = program.getBuildInfo<CL_PROGRAM_BUILD_LOG>(device_);
+    } catch (const cl::Error&) {
+      log = "(no build log)";
+    }
+    // Name the first line of the source, which says which kernel file failed.
+    HAIRMVS_THROW("OpenCL program build failed on '" << device_name_ << "' ("
+                                                      << OpenCLErrorString(e.err())
+                                                      << ", options '" << options << "', source "
+                                                      << source.substr(0, source.find('\n'))
+                                                      << "). Build log:\n"
+                                                      << log);
+  }
+  return programs_.emplace(key, std::move(program)).first->second;
+}
+
+}  // namespace hairmvs
