@@ -1,0 +1,64 @@
+#include "src/core/depth_geometry.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+Eigen::Vector3d BackProjectPixel(const Eigen::Matrix3d& K, double col, double row, double depth) {
+  // Solve K * (x, y, 1) = (u, v, 1) for an upper-triangular K (skew allowed).
+  const double v = row + 0.5;
+  const double u = col + 0.5;
+  const double y = (v - K(1, 2)) / K(1, 1);
+  const double x = (u - K(0, 2) - K(0, 1) * y) / K(0, 0);
+  return Eigen::Vector3d(x * depth, y * depth, depth);
+}
+
+FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
+                               double max_slope) {
+  CHECK_EQ(depth.Channels(), 1);
+  const int width = depth.Width();
+  const int height = depth.Height();
+  FloatMap normals(width, height, 3, 0.0f);
+  const double focal = 0.5 * (K(0, 0) + K(1, 1));
+  auto depth_at = [&](int r, int c) -> double {
+    if (r < 0 || r >= height || c < 0 || c >= width) return 0.0;
+    return depth.At(r, c);
+  };
+  // Tangent along one image direction (dr, dc) at (r, c): central difference when both
+  // neighbours continue the surface, one-sided when only one does, none otherwise.
+  auto tangent = [&](int r, int c, double d, int dr, int dc, Eigen::Vector3d* t) {
+    const double max_jump = max_slope * d / focal;
+    const double d_plus = depth_at(r + dr, c + dc);
+    const double d_minus = depth_at(r - dr, c - dc);
+    const bool plus_ok = d_plus > 0 && std::abs(d_plus - d) <= max_jump;
+    const bool minus_ok = d_minus > 0 && std::abs(d_minus - d) <= max_jump;
+    if (!plus_ok && !minus_ok) return false;
+    const Eigen::Vector3d p_plus = plus_ok ? BackProjectPixel(K, c + dc, r + dr, d_plus)
+                                           : BackProjectPixel(K, c, r, d);
+    const Eigen::Vector3d p_minus = minus_ok ? BackProjectPixel(K, c - dc, r - dr, d_minus)
+                                             : BackProjectPixel(K, c, r, d);
+    *t = p_plus - p_minus;
+    return true;
+  };
+#pragma omp parallel for schedule(static)
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const double d = depth.At(r, c);
+      if (!(d > 0)) continue;
+      Eigen::Vector3d t_col, t_row;
+      if (!tangent(r, c, d, 0, 1, &t_col) || !tangent(r, c, d, 1, 0, &t_row)) continue;
+      Eigen::Vector3d n = t_col.cross(t_row);
+      const double norm = n.norm();
+      if (!(norm > 0)) continue;
+      n /= norm;
+      if (n.dot(BackProjectPixel(K, c, r, d)) > 0) n = -n;
+      for (int k = 0; k < 3; ++k) normals.At(r, c, k) = static_cast<float>(n(k));
+    }
+  }
+  return normals;
+}
+
+}  // namespace hairmvs

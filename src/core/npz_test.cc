@@ -1,0 +1,191 @@
+#include "src/core/npz.h"
+
+#include <gtest/gtest.h>
+#include <zip.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "src/core/file_util.h"
+
+namespace hairmvs {
+namespace {
+
+std::string TestDir(const std::string& name) {
+  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_npz_" + name);
+  std::filesystem::remove_all(dir);
+  CreateDirs(dir);
+  return dir;
+}
+
+void WriteBytes(const std::string& path, const std::string& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(bytes.data(), bytes.size());
+}
+
+// A zip with one entry stored (no compression), as numpy.savez writes it.
+void WriteStoredZip(const std::string& path, const std::string& entry, const std::string& bytes) {
+  int error = 0;
+  zip_t* archive = zip_open(path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error);
+  ASSERT_NE(archive, nullptr);
+  zip_source_t* source = zip_source_buffer(archive, bytes.data(), bytes.size(), 0);
+  const zip_int64_t index = zip_file_add(archive, entry.c_str(), source, 0);
+  ASSERT_GE(index, 0);
+  zip_set_file_compression(archive, index, ZIP_CM_STORE, 0);
+  ASSERT_EQ(zip_close(archive), 0);
+}
+
+std::string ExpectThrowMessage(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no hairmvs::Error thrown";
+  return "";
+}
+
+TEST(Npz, NpyRoundTripAllTypes) {
+  const std::string dir = TestDir("npy");
+  const auto f4 = NpyArray::FromVector<float>({1.5f, -2.f, 3.25f, 0.f, 7.f, 8.f}, {2, 3});
+  WriteNpy(JoinPaths(dir, "a.npy"), f4);
+  const NpyArray back = ReadNpy(JoinPaths(dir, "a.npy"));
+  EXPECT_EQ(back.dtype, "<f4");
+  EXPECT_EQ(back.shape, (std::vector<size_t>{2, 3}));
+  EXPECT_EQ(back.data, f4.data);
+  EXPECT_FLOAT_EQ(back.Data<float>()[2], 3.25f);
+  // The data starts on a 64-byte boundary, as numpy writes it.
+  EXPECT_EQ((FormatNpy(f4).size() - f4.data.size()) % 64, 0u);
+
+  const auto i8 = NpyArray::FromVector<int64_t>({0, 33, 66, int64_t(1) << 40});
+  const NpyArray i8_back = ParseNpy(FormatNpy(i8).data(), FormatNpy(i8).size(), "mem");
+  EXPECT_EQ(i8_back.dtype, "<i8");
+  EXPECT_EQ(i8_back.ToVector<int64_t>()[3], int64_t(1) << 40);
+  EXPECT_EQ(i8_back.ToVector<double>()[1], 33.0);
+
+  const auto scalar = NpyArray::Scalar<int64_t>(960);
+  const std::string scalar_bytes = FormatNpy(scalar);
+  EXPECT_NE(scalar_bytes.find("'shape': ()"), std::string::npos);
+  const NpyArray scalar_back = ParseNpy(scalar_bytes.data(), scalar_bytes.size(), "mem");
+  EXPECT_TRUE(scalar_back.shape.empty());
+  EXPECT_EQ(scalar_back.AsDouble(0), 960.0);
+
+  const auto names = NpyArray::FromStrings({"g0_c.png", "h10.png", "\xc3\xa9"});
+  EXPECT_EQ(names.dtype, "<U8");
+  const std::string names_bytes = FormatNpy(names);
+  const NpyArray names_back = ParseNpy(names_bytes.data(), names_bytes.size(), "mem");
+  EXPECT_EQ(names_back.Strings(),
+            (std::vector<std::string>{"g0_c.png", "h10.png", "\xc3\xa9"}));
+  EXPECT_THROW(names_back.ToVector<float>("names"), Error);
+
+  const auto u1 = NpyArray::FromVector<uint8_t>({0, 1, 2, 255});
+  const auto i4 = NpyArray::FromVector<int32_t>({-5, 7});
+  const auto f8 = NpyArray::FromVector<double>({0.1, 1e300});
+  for (const NpyArray* a : {&u1, &i4, &f8}) {
+    const std::string bytes = FormatNpy(*a);
+    const NpyArray b = ParseNpy(bytes.data(), bytes.size(), "mem");
+    EXPECT_EQ(b.dtype, a->dtype);
+    EXPECT_EQ(b.data, a->data);
+  }
+  EXPECT_EQ(u1.ToVector<int>()[3], 255);
+  EXPECT_EQ(i4.ToVector<double>()[0], -5.0);
+}
+
+TEST(Npz, NpzRoundTripDeflateAndStored) {
+  const std::string dir = TestDir("npz");
+  std::vector<float> depth(40 * 30);
+  for (size_t i = 0; i < depth.size(); ++i) depth[i] = 0.5f + 0.001f * (i % 17);
+  std::map<std::string, NpyArray> arrays;
+  arrays["depth"] = NpyArray::FromVector(depth, {30, 40});
+  arrays["label"] = NpyArray::FromVector(std::vector<uint8_t>(1200, 2), {30, 40});
+  arrays["names"] = NpyArray::FromStrings({"a.png", "bb.png"});
+  const std::string path = JoinPaths(dir, "view.npz");
+  WriteNpz(path, arrays);
+  const auto back = ReadNpz(path);
+  ASSERT_EQ(back.size(), 3u);
+  EXPECT_EQ(back.at("depth").data, arrays["depth"].data);
+  EXPECT_EQ(back.at("depth").shape, (std::vector<size_t>{30, 40}));
+  EXPECT_EQ(back.at("label").dtype, "|u1");
+  EXPECT_EQ(back.at("names").Strings()[1], "bb.png");
+  // Deflated: much smaller than the raw payload.
+  EXPECT_LT(std::filesystem::file_size(path), 1200u * 5);
+  EXPECT_THROW(NpzEntry(back, "normals", path), Error);
+
+  const std::string stored = JoinPaths(dir, "stored.npz");
+  WriteStoredZip(stored, "x.npy", FormatNpy(arrays["depth"]));
+  EXPECT_EQ(ReadNpz(stored).at("x").data, arrays["depth"].data);
+
+  WriteNpz(JoinPaths(dir, "empty.npz"), {});
+  EXPECT_TRUE(ReadNpz(JoinPaths(dir, "empty.npz")).empty());
+}
+
+TEST(Npz, ErrorsNameTheFile) {
+  const std::string dir = TestDir("errors");
+  const std::string missing = JoinPaths(dir, "missing.npz");
+  EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(missing); }).find("missing.npz"), std::string::npos);
+
+  const std::string not_zip = JoinPaths(dir, "not_zip.npz");
+  WriteBytes(not_zip, "hello, this is not a zip archive at all");
+  EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(not_zip); }).find("not_zip.npz"), std::string::npos);
+
+  // A truncated archive (the central directory cut off).
+  std::map<std::string, NpyArray> arrays;
+  arrays["a"] = NpyArray::FromVector(std::vector<float>(1000, 1.f));
+  const std::string good = JoinPaths(dir, "good.npz");
+  WriteNpz(good, arrays);
+  const std::string bytes = ReadTextFile(good);
+  const std::string truncated = JoinPaths(dir, "truncated.npz");
+  WriteBytes(truncated, bytes.substr(0, bytes.size() / 2));
+  EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(truncated); }).find("truncated.npz"),
+            std::string::npos);
+
+  // A non-.npy entry.
+  const std::string text_entry = JoinPaths(dir, "text_entry.npz");
+  WriteStoredZip(text_entry, "readme.txt", "hello");
+  EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(text_entry); }).find("readme.txt"),
+            std::string::npos);
+  // A .npy entry that is not npy data.
+  const std::string bad_npy = JoinPaths(dir, "bad_npy.npz");
+  WriteStoredZip(bad_npy, "a.npy", "definitely not npy");
+  EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(bad_npy); }).find("bad_npy.npz:a.npy"),
+            std::string::npos);
+
+  // Fortran order.
+  std::string fortran = FormatNpy(NpyArray::FromVector<float>({1, 2, 3, 4}, {2, 2}));
+  fortran.replace(fortran.find("False"), 5, "True ");
+  const std::string fortran_path = JoinPaths(dir, "fortran.npy");
+  WriteBytes(fortran_path, fortran);
+  const std::string message = ExpectThrowMessage([&] { ReadNpy(fortran_path); });
+  EXPECT_NE(message.find("fortran.npy"), std::string::npos);
+  EXPECT_NE(message.find("Fortran"), std::string::npos);
+
+  // Truncated payload and trailing bytes.
+  const std::string npy = FormatNpy(NpyArray::FromVector<float>({1, 2, 3, 4}));
+  EXPECT_THROW(ParseNpy(npy.data(), npy.size() - 1, "short"), Error);
+  const std::string longer = npy + "x";
+  EXPECT_THROW(ParseNpy(longer.data(), longer.size(), "long"), Error);
+  // Unsupported dtype.
+  std::string complex = npy;
+  complex.replace(complex.find("<f4"), 3, "<c8");
+  EXPECT_NE(ExpectThrowMessage([&] { ParseNpy(complex.data(), complex.size(), "cplx.npy"); })
+                .find("cplx.npy"),
+            std::string::npos);
+}
+
+// The shared data sets' files, written by numpy itself.
+TEST(Npz, ReadsNumpyWrittenGroundTruth) {
+  const std::string gt = JoinPaths(HAIRMVS_SHARED_DATA_DIR, "synth_straight_gantry", "gt");
+  if (!ExistsFile(JoinPaths(gt, "cameras.npz"))) GTEST_SKIP() << "no shared data at " << gt;
+  const auto cameras = ReadNpz(JoinPaths(gt, "cameras.npz"));
+  const NpyArray& names = cameras.at("names");
+  EXPECT_EQ(names.shape, (std::vector<size_t>{32}));
+  EXPECT_EQ(names.Strings()[0].substr(0, 2), "g0");
+  EXPECT_EQ(cameras.at("R").shape, (std::vector<size_t>{32, 3, 3}));
+  EXPECT_EQ(cameras.at("width").AsDouble(0), 960.0);
+  const NpyArray offsets = ReadNpy(JoinPaths(gt, "strands_offsets.npy"));
+  EXPECT_EQ(offsets.dtype, "<i8");
+  EXPECT_EQ(offsets.shape, (std::vector<size_t>{40001}));
+}
+
+}  // namespace
+}  // namespace hairmvs
