@@ -1,0 +1,666 @@
+#include "colmap_ext/reconstruction.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <charconv>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+static_assert(sizeof(double) == 8, "IEEE-754 double expected");
+
+const std::vector<CameraModelInfo>& CameraModels() {
+  // colmap-formats.md section 4.2 (ids and parameter counts of COLMAP 3.8 through 4.1).
+  static const std::vector<CameraModelInfo> kModels = {
+      {0, "SIMPLE_PINHOLE", 3},
+      {1, "PINHOLE", 4},
+      {2, "SIMPLE_RADIAL", 4},
+      {3, "RADIAL", 5},
+      {4, "OPENCV", 8},
+      {5, "OPENCV_FISHEYE", 8},
+      {6, "FULL_OPENCV", 12},
+      {7, "FOV", 5},
+      {8, "SIMPLE_RADIAL_FISHEYE", 4},
+      {9, "RADIAL_FISHEYE", 5},
+      {10, "THIN_PRISM_FISHEYE", 12},
+      {11, "RAD_TAN_THIN_PRISM_FISHEYE", 16},
+      {12, "SIMPLE_DIVISION", 4},
+      {13, "DIVISION", 5},
+      {14, "SIMPLE_FISHEYE", 3},
+      {15, "FISHEYE", 4},
+      {16, "EUCM", 6},
+      {17, "EQUIRECTANGULAR", 2},
+  };
+  return kModels;
+}
+
+const CameraModelInfo& CameraModelById(int model_id) {
+  for (const CameraModelInfo& info : CameraModels()) {
+    if (info.id == model_id) return info;
+  }
+  HAIRMVS_THROW("Unknown camera model id " << model_id << " (known: 0-17)");
+}
+
+const CameraModelInfo& CameraModelByName(const std::string& name) {
+  for (const CameraModelInfo& info : CameraModels()) {
+    if (name == info.name) return info;
+  }
+  HAIRMVS_THROW("Unknown camera model name '" << name << "'");
+}
+
+std::string Camera::ModelName() const { return CameraModelById(model_id).name; }
+
+bool Camera::IsPinhole() const { return model_id == 0 || model_id == 1; }
+
+Eigen::Matrix3d Camera::CalibrationMatrix() const {
+  THROW_IF(!IsPinhole(), "Camera " << camera_id << " has model " << ModelName()
+                                   << "; the dense stage needs undistorted PINHOLE or "
+                                      "SIMPLE_PINHOLE cameras: run `colmap image_undistorter`");
+  THROW_IF(params.size() != static_cast<size_t>(CameraModelById(model_id).num_params),
+           "Camera " << camera_id << " has " << params.size() << " parameters for "
+                     << ModelName());
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  if (model_id == 0) {
+    K(0, 0) = K(1, 1) = params[0];
+    K(0, 2) = params[1];
+    K(1, 2) = params[2];
+  } else {
+    K(0, 0) = params[0];
+    K(1, 1) = params[1];
+    K(0, 2) = params[2];
+    K(1, 2) = params[3];
+  }
+  return K;
+}
+
+const Image* Reconstruction::FindImageByName(const std::string& name) const {
+  for (const auto& [id, image] : images) {
+    if (image.name == name) return &image;
+  }
+  return nullptr;
+}
+
+const Image& Reconstruction::ImageByName(const std::string& name) const {
+  const Image* image = FindImageByName(name);
+  THROW_IF(image == nullptr, "Image with name `" << name << "` does not exist in the model");
+  return *image;
+}
+
+void Reconstruction::SortImageOrder() {
+  image_order.clear();
+  for (const auto& [id, image] : images) image_order.push_back(id);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Binary helpers.
+
+namespace {
+
+template <typename T>
+T ReadBinary(std::istream& in, const std::string& source, const char* what) {
+  T value;
+  in.read(reinterpret_cast<char*>(&value), sizeof(T));
+  THROW_IF(in.gcount() != static_cast<std::streamsize>(sizeof(T)),
+           source << ": truncated file while reading " << what);
+  return value;  // little-endian host assumed (x86-64, aarch64), as COLMAP does
+}
+
+template <typename T>
+void WriteBinary(std::ostream& out, const T& value) {
+  out.write(reinterpret_cast<const char*>(&value), sizeof(T));
+}
+
+void RequireEnd(std::istream& in, const std::string& source) {
+  if (in.peek() == std::char_traits<char>::eof()) return;
+  const std::streampos pos = in.tellg();
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const std::streampos end = in.tellg();
+  HAIRMVS_THROW(source << ": " << (end - pos)
+                       << " unexpected bytes after the last record (oversized file, or a "
+                          "count that does not match the records)");
+}
+
+// Bounded reserve: a corrupt count must not allocate terabytes before the truncation shows.
+template <typename V>
+void ReserveBounded(V* v, uint64_t n) {
+  v->reserve(static_cast<size_t>(std::min<uint64_t>(n, 1u << 16)));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Text helpers: COLMAP 3.8 splits on single spaces after trimming the line (section 4.5).
+
+struct TextLine {
+  std::vector<std::string> tokens;
+  int line_number = 0;
+};
+
+// Splits a trimmed line on single spaces. A doubled space (empty token) or a tab is rejected:
+// COLMAP 3.8 aborts on such a file, so we name the problem instead.
+std::vector<std::string> SplitSingleSpaces(const std::string& line, const std::string& where) {
+  std::vector<std::string> tokens;
+  if (line.empty()) return tokens;
+  THROW_IF(line.find('\t') != std::string::npos,
+           where << ": tab character; COLMAP 3.8 text files separate tokens by single spaces");
+  size_t start = 0;
+  while (true) {
+    const size_t pos = line.find(' ', start);
+    std::string token = line.substr(start, pos == std::string::npos ? std::string::npos
+                                                                     : pos - start);
+    THROW_IF(token.empty(), where << ": doubled space; COLMAP 3.8 text files separate tokens "
+                                     "by exactly one space (3.8 aborts on this)");
+    tokens.push_back(std::move(token));
+    if (pos == std::string::npos) break;
+    start = pos + 1;
+  }
+  return tokens;
+}
+
+std::string TrimLine(std::string line) { return StripWhitespace(line); }
+
+std::string Where(const std::string& source, int line_number) {
+  std::ostringstream ss;
+  ss << source << ":" << line_number;
+  return ss.str();
+}
+
+template <typename T>
+T ParseInteger(const std::string& token, const std::string& where, const char* what) {
+  T value{};
+  const char* begin = token.data();
+  const char* end = token.data() + token.size();
+  const auto result = std::from_chars(begin, end, value);
+  THROW_IF(result.ec != std::errc() || result.ptr != end,
+           where << ": cannot parse " << what << " from '" << token << "'");
+  return value;
+}
+
+double ParseDouble(const std::string& token, const std::string& where, const char* what) {
+  errno = 0;
+  char* end = nullptr;
+  const double value = std::strtod(token.c_str(), &end);
+  THROW_IF(end != token.c_str() + token.size() || token.empty() || errno == ERANGE,
+           where << ": cannot parse " << what << " from '" << token << "'");
+  return value;
+}
+
+// Point3D ids in text: -1 means none.
+uint64_t ParsePoint3DId(const std::string& token, const std::string& where) {
+  if (token == "-1") return kInvalidPoint3DId;
+  return ParseInteger<uint64_t>(token, where, "POINT3D_ID");
+}
+
+Eigen::Quaterniond NormalizedQuaternion(double qw, double qx, double qy, double qz,
+                                        const std::string& where) {
+  Eigen::Quaterniond q(qw, qx, qy, qz);
+  const double norm = q.norm();
+  THROW_IF(!(norm > 1e-12) || !std::isfinite(norm),
+           where << ": invalid rotation quaternion (norm " << norm << ")");
+  // COLMAP 3.8 normalises quaternions when reading (section 4.3).
+  q.coeffs() /= norm;
+  return q;
+}
+
+void SetCameraParams(Camera* camera, std::vector<double> params, const std::string& where) {
+  const CameraModelInfo& info = CameraModelById(camera->model_id);
+  THROW_IF(params.size() != static_cast<size_t>(info.num_params),
+           where << ": camera " << camera->camera_id << " of model " << info.name << " has "
+                 << params.size() << " parameters, expected " << info.num_params);
+  camera->params = std::move(params);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Binary readers.
+
+void ReadCamerasBinary(std::istream& in, const std::string& source, Reconstruction* r) {
+  const uint64_t num_cameras = ReadBinary<uint64_t>(in, source, "num_cameras");
+  for (uint64_t i = 0; i < num_cameras; ++i) {
+    Camera camera;
+    camera.camera_id = ReadBinary<uint32_t>(in, source, "camera_id");
+    const int32_t model_id = ReadBinary<int32_t>(in, source, "model_id");
+    const CameraModelInfo* info = nullptr;
+    try {
+      info = &CameraModelById(model_id);
+    } catch (const Error& e) {
+      HAIRMVS_THROW(source << ": camera " << camera.camera_id << ": " << e.what());
+    }
+    camera.model_id = model_id;
+    camera.width = ReadBinary<uint64_t>(in, source, "camera width");
+    camera.height = ReadBinary<uint64_t>(in, source, "camera height");
+    camera.params.resize(info->num_params);
+    for (double& p : camera.params) p = ReadBinary<double>(in, source, "camera parameters");
+    THROW_IF(r->cameras.count(camera.camera_id),
+             source << ": duplicate camera_id " << camera.camera_id);
+    r->cameras[camera.camera_id] = std::move(camera);
+  }
+  RequireEnd(in, source);
+}
+
+void ReadImagesBinary(std::istream& in, const std::string& source, Reconstruction* r) {
+  const uint64_t num_images = ReadBinary<uint64_t>(in, source, "num_reg_images");
+  r->image_order.clear();
+  ReserveBounded(&r->image_order, num_images);
+  for (uint64_t i = 0; i < num_images; ++i) {
+    Image image;
+    image.image_id = ReadBinary<uint32_t>(in, source, "image_id");
+    double q[4];
+    for (double& v : q) v = ReadBinary<double>(in, source, "image rotation");
+    std::ostringstream where;
+    where << source << ": image " << image.image_id;
+    image.cam_from_world_rotation = NormalizedQuaternion(q[0], q[1], q[2], q[3], where.str());
+    for (int k = 0; k < 3; ++k) {
+      image.cam_from_world_translation[k] = ReadBinary<double>(in, source, "image translation");
+    }
+    image.camera_id = ReadBinary<uint32_t>(in, source, "image camera_id");
+    // NUL-terminated name.
+    std::string name;
+    while (true) {
+      const char c = ReadBinary<char>(in, source, "image name (no terminating NUL)");
+      if (c == '\0') break;
+      name.push_back(c);
+      THROW_IF(name.size() > 65536, source << ": image name longer than 64 KiB (corrupt file)");
+    }
+    THROW_IF(name.empty(), where.str() << ": empty image name");
+    image.name = std::move(name);
+    const uint64_t num_points2D = ReadBinary<uint64_t>(in, source, "num_points2D");
+    ReserveBounded(&image.points2D, num_points2D);
+    for (uint64_t k = 0; k < num_points2D; ++k) {
+      Point2D p;
+      p.xy.x() = ReadBinary<double>(in, source, "point2D x");
+      p.xy.y() = ReadBinary<double>(in, source, "point2D y");
+      p.point3D_id = ReadBinary<uint64_t>(in, source, "point2D point3D_id");
+      image.points2D.push_back(p);
+    }
+    THROW_IF(r->images.count(image.image_id),
+             source << ": duplicate image_id " << image.image_id);
+    r->image_order.push_back(image.image_id);
+    r->images[image.image_id] = std::move(image);
+  }
+  RequireEnd(in, source);
+}
+
+void ReadPoints3DBinary(std::istream& in, const std::string& source, Reconstruction* r) {
+  const uint64_t num_points = ReadBinary<uint64_t>(in, source, "num_points3D");
+  for (uint64_t i = 0; i < num_points; ++i) {
+    Point3D point;
+    point.point3D_id = ReadBinary<uint64_t>(in, source, "point3D_id");
+    for (int k = 0; k < 3; ++k) point.xyz[k] = ReadBinary<double>(in, source, "point3D xyz");
+    for (int k = 0; k < 3; ++k) point.rgb[k] = ReadBinary<uint8_t>(in, source, "point3D rgb");
+    point.error = ReadBinary<double>(in, source, "point3D error");
+    const uint64_t track_length = ReadBinary<uint64_t>(in, source, "track_length");
+    ReserveBounded(&point.track, track_length);
+    for (uint64_t k = 0; k < track_length; ++k) {
+      TrackElement el;
+      el.image_id = ReadBinary<uint32_t>(in, source, "track image_id");
+      el.point2D_idx = ReadBinary<uint32_t>(in, source, "track point2D_idx");
+      point.track.push_back(el);
+    }
+    THROW_IF(r->points3D.count(point.point3D_id),
+             source << ": duplicate point3D_id " << point.point3D_id);
+    r->points3D[point.point3D_id] = std::move(point);
+  }
+  RequireEnd(in, source);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Text readers.
+
+void ReadCamerasText(std::istream& in, const std::string& source, Reconstruction* r) {
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    line = TrimLine(line);
+    if (line.empty() || line[0] == '#') continue;
+    const std::string where = Where(source, line_number);
+    const std::vector<std::string> tokens = SplitSingleSpaces(line, where);
+    THROW_IF(tokens.size() < 4,
+             where << ": expected CAMERA_ID MODEL WIDTH HEIGHT PARAMS[], found " << tokens.size()
+                   << " tokens");
+    Camera camera;
+    camera.camera_id = ParseInteger<uint32_t>(tokens[0], where, "CAMERA_ID");
+    try {
+      camera.model_id = CameraModelByName(tokens[1]).id;
+    } catch (const Error& e) {
+      HAIRMVS_THROW(where << ": " << e.what());
+    }
+    camera.width = ParseInteger<uint64_t>(tokens[2], where, "WIDTH");
+    camera.height = ParseInteger<uint64_t>(tokens[3], where, "HEIGHT");
+    std::vector<double> params;
+    for (size_t k = 4; k < tokens.size(); ++k) {
+      params.push_back(ParseDouble(tokens[k], where, "camera parameter"));
+    }
+    SetCameraParams(&camera, std::move(params), where);
+    THROW_IF(r->cameras.count(camera.camera_id),
+             where << ": duplicate camera_id " << camera.camera_id);
+    r->cameras[camera.camera_id] = std::move(camera);
+  }
+}
+
+void ReadImagesText(std::istream& in, const std::string& source, Reconstruction* r) {
+  std::string line;
+  int line_number = 0;
+  r->image_order.clear();
+  while (std::getline(in, line)) {
+    ++line_number;
+    line = TrimLine(line);
+    // Only the first line of a pair may be a comment or empty (section 4.3).
+    if (line.empty() || line[0] == '#') continue;
+    const std::string where = Where(source, line_number);
+    const std::vector<std::string> tokens = SplitSingleSpaces(line, where);
+    THROW_IF(tokens.size() != 10,
+             where << ": expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME (10 tokens), found "
+                   << tokens.size() << " (image names must not contain spaces)");
+    Image image;
+    image.image_id = ParseInteger<uint32_t>(tokens[0], where, "IMAGE_ID");
+    double q[4];
+    for (int k = 0; k < 4; ++k) q[k] = ParseDouble(tokens[1 + k], where, "quaternion");
+    image.cam_from_world_rotation = NormalizedQuaternion(q[0], q[1], q[2], q[3], where);
+    for (int k = 0; k < 3; ++k) {
+      image.cam_from_world_translation[k] = ParseDouble(tokens[5 + k], where, "translation");
+    }
+    image.camera_id = ParseInteger<uint32_t>(tokens[8], where, "CAMERA_ID");
+    image.name = tokens[9];
+    // The second line (POINTS2D) is required, even when empty.
+    THROW_IF(!std::getline(in, line),
+             where << ": image " << image.image_id
+                   << " has no second line (POINTS2D[] as X Y POINT3D_ID; write an empty line "
+                      "when there are none)");
+    ++line_number;
+    line = TrimLine(line);
+    const std::string where2 = Where(source, line_number);
+    THROW_IF(!line.empty() && line[0] == '#',
+             where2 << ": expected the POINTS2D line of image " << image.image_id
+                    << ", found a comment (two lines per image)");
+    const std::vector<std::string> p = SplitSingleSpaces(line, where2);
+    THROW_IF(p.size() % 3 != 0,
+             where2 << ": POINTS2D line of image " << image.image_id << " has " << p.size()
+                    << " tokens, not a multiple of 3 (X Y POINT3D_ID)");
+    for (size_t k = 0; k < p.size(); k += 3) {
+      Point2D point;
+      point.xy.x() = ParseDouble(p[k], where2, "point2D X");
+      point.xy.y() = ParseDouble(p[k + 1], where2, "point2D Y");
+      point.point3D_id = ParsePoint3DId(p[k + 2], where2);
+      image.points2D.push_back(point);
+    }
+    THROW_IF(r->images.count(image.image_id),
+             where << ": duplicate image_id " << image.image_id);
+    r->image_order.push_back(image.image_id);
+    r->images[image.image_id] = std::move(image);
+  }
+}
+
+void ReadPoints3DText(std::istream& in, const std::string& source, Reconstruction* r) {
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    line = TrimLine(line);
+    if (line.empty() || line[0] == '#') continue;
+    const std::string where = Where(source, line_number);
+    const std::vector<std::string> tokens = SplitSingleSpaces(line, where);
+    THROW_IF(tokens.size() < 8 || (tokens.size() - 8) % 2 != 0,
+             where << ": expected POINT3D_ID X Y Z R G B ERROR (IMAGE_ID POINT2D_IDX)*, found "
+                   << tokens.size() << " tokens");
+    Point3D point;
+    point.point3D_id = ParseInteger<uint64_t>(tokens[0], where, "POINT3D_ID");
+    for (int k = 0; k < 3; ++k) point.xyz[k] = ParseDouble(tokens[1 + k], where, "X/Y/Z");
+    for (int k = 0; k < 3; ++k) {
+      const int value = ParseInteger<int>(tokens[4 + k], where, "R/G/B");
+      THROW_IF(value < 0 || value > 255, where << ": colour " << value << " outside 0-255");
+      point.rgb[k] = static_cast<uint8_t>(value);
+    }
+    point.error = ParseDouble(tokens[7], where, "ERROR");
+    for (size_t k = 8; k < tokens.size(); k += 2) {
+      TrackElement el;
+      el.image_id = ParseInteger<uint32_t>(tokens[k], where, "track IMAGE_ID");
+      el.point2D_idx = ParseInteger<uint32_t>(tokens[k + 1], where, "track POINT2D_IDX");
+      point.track.push_back(el);
+    }
+    THROW_IF(r->points3D.count(point.point3D_id),
+             where << ": duplicate point3D_id " << point.point3D_id);
+    r->points3D[point.point3D_id] = std::move(point);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writers: every record sorted by id.
+
+namespace {
+
+// Sorted by image_id, as the header promises: the file order is COLMAP 3.8's image_idx, so
+// whoever writes .vis indices must number images by ascending id (SortImageOrder()).
+std::vector<uint32_t> ImageWriteOrder(const Reconstruction& r) {
+  std::vector<uint32_t> order;
+  for (const auto& [id, image] : r.images) order.push_back(id);
+  return order;
+}
+
+void CheckCamera(const Camera& camera) {
+  const CameraModelInfo& info = CameraModelById(camera.model_id);
+  CHECK_EQ(camera.params.size(), static_cast<size_t>(info.num_params))
+      << "camera " << camera.camera_id << " of model " << info.name;
+}
+
+void CheckWritableName(const std::string& name) {
+  THROW_IF(name.empty() || name.find_first_of(" \t\r\n") != std::string::npos ||
+               name.find('\0') != std::string::npos,
+           "Image name '" << name << "' cannot be written: COLMAP names must be non-empty and "
+                             "contain no whitespace");
+}
+
+Eigen::Quaterniond UnitQuaternion(const Eigen::Quaterniond& q) {
+  return Eigen::Quaterniond(q.coeffs() / q.norm());
+}
+
+}  // namespace
+
+void WriteCamerasBinary(const Reconstruction& r, std::ostream& out) {
+  WriteBinary<uint64_t>(out, r.cameras.size());
+  for (const auto& [id, camera] : r.cameras) {
+    CheckCamera(camera);
+    WriteBinary<uint32_t>(out, camera.camera_id);
+    WriteBinary<int32_t>(out, camera.model_id);
+    WriteBinary<uint64_t>(out, camera.width);
+    WriteBinary<uint64_t>(out, camera.height);
+    for (double p : camera.params) WriteBinary<double>(out, p);
+  }
+}
+
+void WriteImagesBinary(const Reconstruction& r, std::ostream& out) {
+  WriteBinary<uint64_t>(out, r.images.size());
+  for (uint32_t id : ImageWriteOrder(r)) {
+    const Image& image = r.images.at(id);
+    CheckWritableName(image.name);
+    WriteBinary<uint32_t>(out, image.image_id);
+    const Eigen::Quaterniond q = UnitQuaternion(image.cam_from_world_rotation);
+    WriteBinary<double>(out, q.w());
+    WriteBinary<double>(out, q.x());
+    WriteBinary<double>(out, q.y());
+    WriteBinary<double>(out, q.z());
+    for (int k = 0; k < 3; ++k) WriteBinary<double>(out, image.cam_from_world_translation[k]);
+    WriteBinary<uint32_t>(out, image.camera_id);
+    out.write(image.name.c_str(), static_cast<std::streamsize>(image.name.size() + 1));
+    WriteBinary<uint64_t>(out, image.points2D.size());
+    for (const Point2D& p : image.points2D) {
+      WriteBinary<double>(out, p.xy.x());
+      WriteBinary<double>(out, p.xy.y());
+      WriteBinary<uint64_t>(out, p.point3D_id);
+    }
+  }
+}
+
+void WritePoints3DBinary(const Reconstruction& r, std::ostream& out) {
+  WriteBinary<uint64_t>(out, r.points3D.size());
+  for (const auto& [id, point] : r.points3D) {
+    WriteBinary<uint64_t>(out, point.point3D_id);
+    for (int k = 0; k < 3; ++k) WriteBinary<double>(out, point.xyz[k]);
+    for (int k = 0; k < 3; ++k) WriteBinary<uint8_t>(out, point.rgb[k]);
+    WriteBinary<double>(out, point.error);
+    WriteBinary<uint64_t>(out, point.track.size());
+    for (const TrackElement& el : point.track) {
+      WriteBinary<uint32_t>(out, el.image_id);
+      WriteBinary<uint32_t>(out, el.point2D_idx);
+    }
+  }
+}
+
+// Text: 17 significant digits so that doubles round-trip exactly; single spaces only.
+void WriteCamerasText(const Reconstruction& r, std::ostream& out) {
+  out << std::setprecision(17);
+  out << "# Camera list with one line of data per camera:\n"
+      << "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+      << "# Number of cameras: " << r.cameras.size() << "\n";
+  for (const auto& [id, camera] : r.cameras) {
+    CheckCamera(camera);
+    out << camera.camera_id << " " << camera.ModelName() << " " << camera.width << " "
+        << camera.height;
+    for (double p : camera.params) out << " " << p;
+    out << "\n";
+  }
+}
+
+void WriteImagesText(const Reconstruction& r, std::ostream& out) {
+  out << std::setprecision(17);
+  size_t num_observations = 0;
+  for (const auto& [id, image] : r.images) num_observations += image.points2D.size();
+  out << "# Image list with two lines of data per image:\n"
+      << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+      << "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+      << "# Number of images: " << r.images.size()
+      << ", mean observations per image: "
+      << (r.images.empty() ? 0.0 : static_cast<double>(num_observations) / r.images.size())
+      << "\n";
+  for (uint32_t id : ImageWriteOrder(r)) {
+    const Image& image = r.images.at(id);
+    CheckWritableName(image.name);
+    const Eigen::Quaterniond q = UnitQuaternion(image.cam_from_world_rotation);
+    const Eigen::Vector3d& t = image.cam_from_world_translation;
+    out << image.image_id << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " "
+        << t.x() << " " << t.y() << " " << t.z() << " " << image.camera_id << " " << image.name
+        << "\n";
+    bool first = true;
+    for (const Point2D& p : image.points2D) {
+      if (!first) out << " ";
+      first = false;
+      out << p.xy.x() << " " << p.xy.y() << " ";
+      if (p.point3D_id == kInvalidPoint3DId) {
+        out << -1;
+      } else {
+        out << p.point3D_id;
+      }
+    }
+    out << "\n";
+  }
+}
+
+void WritePoints3DText(const Reconstruction& r, std::ostream& out) {
+  out << std::setprecision(17);
+  size_t track_sum = 0;
+  for (const auto& [id, point] : r.points3D) track_sum += point.track.size();
+  out << "# 3D point list with one line of data per point:\n"
+      << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+      << "# Number of points: " << r.points3D.size() << ", mean track length: "
+      << (r.points3D.empty() ? 0.0 : static_cast<double>(track_sum) / r.points3D.size())
+      << "\n";
+  for (const auto& [id, point] : r.points3D) {
+    out << point.point3D_id << " " << point.xyz.x() << " " << point.xyz.y() << " "
+        << point.xyz.z() << " " << static_cast<int>(point.rgb[0]) << " "
+        << static_cast<int>(point.rgb[1]) << " " << static_cast<int>(point.rgb[2]) << " "
+        << point.error;
+    for (const TrackElement& el : point.track) {
+      out << " " << el.image_id << " " << el.point2D_idx;
+    }
+    out << "\n";
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Folders.
+
+namespace {
+
+void ReadFile(const std::string& path,
+              void (*reader)(std::istream&, const std::string&, Reconstruction*),
+              Reconstruction* r, bool binary) {
+  std::ifstream in(path, binary ? std::ios::binary : std::ios::in);
+  THROW_IF(!in, "Cannot open " << path);
+  reader(in, path, r);
+}
+
+}  // namespace
+
+Reconstruction ReadReconstruction(const std::string& dir) {
+  THROW_IF(!ExistsDir(dir), "Missing sparse model folder: " << dir);
+  const char* kNames[3] = {"cameras", "images", "points3D"};
+  auto all_exist = [&](const char* ext) {
+    for (const char* name : kNames) {
+      if (!ExistsFile(JoinPaths(dir, std::string(name) + ext))) return false;
+    }
+    return true;
+  };
+  Reconstruction r;
+  // COLMAP's rule: binary if all three .bin files exist, else text. rigs.* / frames.*
+  // (COLMAP 3.12+) are ignored: images.* still holds every pose.
+  if (all_exist(".bin")) {
+    ReadFile(JoinPaths(dir, "cameras.bin"), ReadCamerasBinary, &r, true);
+    ReadFile(JoinPaths(dir, "images.bin"), ReadImagesBinary, &r, true);
+    ReadFile(JoinPaths(dir, "points3D.bin"), ReadPoints3DBinary, &r, true);
+  } else if (all_exist(".txt")) {
+    ReadFile(JoinPaths(dir, "cameras.txt"), ReadCamerasText, &r, false);
+    ReadFile(JoinPaths(dir, "images.txt"), ReadImagesText, &r, false);
+    ReadFile(JoinPaths(dir, "points3D.txt"), ReadPoints3DText, &r, false);
+  } else {
+    std::ostringstream hint;
+    if (ExistsDir(JoinPaths(dir, "0"))) {
+      hint << " (found a sub-folder 0/: the model must sit directly in " << dir << ")";
+    }
+    HAIRMVS_THROW("cameras, images, points3D files do not exist at " << dir
+                  << ": need all three of cameras.bin, images.bin, points3D.bin or of "
+                     "cameras.txt, images.txt, points3D.txt"
+                  << hint.str());
+  }
+  const std::string images_file =
+      JoinPaths(dir, all_exist(".bin") ? "images.bin" : "images.txt");
+  for (const auto& [id, image] : r.images) {
+    THROW_IF(!r.cameras.count(image.camera_id),
+             images_file << ": image " << id << " (" << image.name << ") refers to camera "
+                         << image.camera_id << ", which is not in the cameras file");
+  }
+  return r;
+}
+
+void WriteReconstruction(const Reconstruction& reconstruction, const std::string& dir,
+                         ModelFormat format) {
+  CreateDirs(dir);
+  if (format == ModelFormat::kBinary) {
+    WriteFileAtomically(JoinPaths(dir, "cameras.bin"),
+                        [&](std::ostream& out) { WriteCamerasBinary(reconstruction, out); });
+    WriteFileAtomically(JoinPaths(dir, "images.bin"),
+                        [&](std::ostream& out) { WriteImagesBinary(reconstruction, out); });
+    WriteFileAtomically(JoinPaths(dir, "points3D.bin"),
+                        [&](std::ostream& out) { WritePoints3DBinary(reconstruction, out); });
+  } else {
+    WriteFileAtomically(
+        JoinPaths(dir, "cameras.txt"),
+        [&](std::ostream& out) { WriteCamerasText(reconstruction, out); }, false);
+    WriteFileAtomically(
+        JoinPaths(dir, "images.txt"),
+        [&](std::ostream& out) { WriteImagesText(reconstruction, out); }, false);
+    WriteFileAtomically(
+        JoinPaths(dir, "points3D.txt"),
+        [&](std::ostream& out) { WritePoints3DText(reconstruction, out); }, false);
+  }
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,209 @@
+#include "colmap_ext/workspace.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <sstream>
+
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+Workspace Workspace::Read(const std::string& path, const std::string& mask_path) {
+  THROW_IF(path.empty(), "Empty workspace path (--workspace_path)");
+  THROW_IF(!ExistsDir(path), "Missing workspace folder: " << path);
+  const std::string sparse = JoinPaths(path, "sparse");
+  const std::string images = JoinPaths(path, "images");
+  THROW_IF(!ExistsDir(sparse),
+           "Missing sparse model: " << sparse
+                                    << " (a COLMAP dense workspace as `colmap image_undistorter "
+                                       "--output_type COLMAP` writes it)");
+  Workspace ws;
+  ws.path_ = path;
+  ws.model_ = ReadReconstruction(sparse);
+  THROW_IF(ws.model_.images.empty(),
+           "Empty workspace: the sparse model in " << sparse << " has no images");
+  THROW_IF(!ExistsDir(images), "Missing images folder: " << images);
+  for (uint32_t id : ws.model_.image_order) {
+    const Image& image = ws.model_.images.at(id);
+    const std::string image_path = JoinPaths(images, image.name);
+    THROW_IF(!ExistsFile(image_path), "Image " << image.name << " is listed in the model "
+                                               << sparse << " but missing: " << image_path);
+    ws.image_names_.push_back(image.name);
+  }
+  if (!mask_path.empty()) {
+    THROW_IF(!ExistsDir(mask_path), "Missing mask folder (--mask_path): " << mask_path);
+    ws.mask_path_ = mask_path;
+  } else if (ExistsDir(JoinPaths(path, "masks"))) {
+    ws.mask_path_ = JoinPaths(path, "masks");
+  }
+  return ws;
+}
+
+int Workspace::ImageIdx(const std::string& name) const {
+  const auto it = std::find(image_names_.begin(), image_names_.end(), name);
+  THROW_IF(it == image_names_.end(),
+           "Image with name `" << name << "` does not exist in workspace " << path_);
+  return static_cast<int>(it - image_names_.begin());
+}
+
+const Image& Workspace::ImageByName(const std::string& name) const {
+  const Image* image = model_.FindImageByName(name);
+  THROW_IF(image == nullptr,
+           "Image with name `" << name << "` does not exist in workspace " << path_);
+  return *image;
+}
+
+const Camera& Workspace::CameraOf(const std::string& name) const {
+  const Image& image = ImageByName(name);
+  const Camera& camera = model_.cameras.at(image.camera_id);
+  THROW_IF(!camera.IsPinhole(),
+           "Image " << name << " in " << path_ << " has a " << camera.ModelName()
+                    << " camera; the dense stage needs PINHOLE or SIMPLE_PINHOLE: run `colmap "
+                       "image_undistorter --output_type COLMAP` first");
+  return camera;
+}
+
+std::string Workspace::ImagePath(const std::string& name) const {
+  return JoinPaths(path_, "images", name);
+}
+
+std::string Workspace::MaskPath(const std::string& name) const {
+  if (mask_path_.empty()) return "";
+  // COLMAP's fusion naming: <mask_path>/<image name>.png; 3.12+ also accepts the name itself
+  // when it already ends in .png.
+  const std::string path = JoinPaths(mask_path_, name + ".png");
+  if (ExistsFile(path)) return path;
+  if (name.size() > 4 && name.compare(name.size() - 4, 4, ".png") == 0) {
+    const std::string same = JoinPaths(mask_path_, name);
+    if (ExistsFile(same)) return same;
+  }
+  return "";
+}
+
+std::string Workspace::StereoPath() const { return JoinPaths(path_, "stereo"); }
+
+std::string Workspace::DepthMapPath(const std::string& name, const std::string& type) const {
+  THROW_IF(type != "geometric" && type != "photometric",
+           "Unknown depth map type '" << type << "' (geometric or photometric)");
+  return JoinPaths(StereoPath(), "depth_maps", name + "." + type + ".bin");
+}
+
+std::string Workspace::NormalMapPath(const std::string& name, const std::string& type) const {
+  THROW_IF(type != "geometric" && type != "photometric",
+           "Unknown normal map type '" << type << "' (geometric or photometric)");
+  return JoinPaths(StereoPath(), "normal_maps", name + "." + type + ".bin");
+}
+
+// hairmvs's own per-view maps, named like COLMAP's: stereo/<kind>_maps/<image name>.<...>.bin.
+std::string Workspace::ConfidenceMapPath(const std::string& name) const {
+  return JoinPaths(StereoPath(), "confidence_maps", name + ".bin");
+}
+
+std::string Workspace::OrientationMapPath(const std::string& name, int level) const {
+  CHECK_GE(level, 0);
+  return JoinPaths(StereoPath(), "orientation_maps",
+                   name + ".level" + std::to_string(level) + ".bin");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Images.
+
+namespace {
+
+cv::Mat ReadUnchanged(const std::string& path, const char* what) {
+  RequireFile(path, what);
+  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
+  THROW_IF(image.empty(), "Cannot decode " << what << " " << path);
+  return image;
+}
+
+// To float in [0, 1] from 8- or 16-bit (or float) data.
+cv::Mat ToUnitFloat(const cv::Mat& image, const std::string& path) {
+  cv::Mat out;
+  switch (image.depth()) {
+    case CV_8U: image.convertTo(out, CV_32F, 1.0 / 255.0); break;
+    case CV_16U: image.convertTo(out, CV_32F, 1.0 / 65535.0); break;
+    case CV_32F: out = image; break;
+    default: HAIRMVS_THROW("Unsupported pixel depth in image " << path);
+  }
+  return out;
+}
+
+FloatMap FromPlanes(const std::vector<cv::Mat>& planes) {
+  CHECK(!planes.empty());
+  FloatMap map(planes[0].cols, planes[0].rows, static_cast<int>(planes.size()));
+  for (size_t c = 0; c < planes.size(); ++c) {
+    for (int r = 0; r < planes[c].rows; ++r) {
+      const float* row = planes[c].ptr<float>(r);
+      std::copy(row, row + planes[c].cols, map.Channel(static_cast<int>(c)) + r * map.Width());
+    }
+  }
+  return map;
+}
+
+// OpenCV order is BGR(A); returns R, G, B float planes.
+std::vector<cv::Mat> RgbPlanes(const cv::Mat& image, const std::string& path) {
+  const cv::Mat f = ToUnitFloat(image, path);
+  std::vector<cv::Mat> channels;
+  cv::split(f, channels);
+  if (channels.size() == 1 || channels.size() == 2) {  // grey (+ alpha)
+    return {channels[0], channels[0], channels[0]};
+  }
+  THROW_IF(channels.size() != 3 && channels.size() != 4,
+           "Unsupported number of channels (" << channels.size() << ") in image " << path);
+  return {channels[2], channels[1], channels[0]};
+}
+
+}  // namespace
+
+FloatMap ReadImageGray(const std::string& path) {
+  const cv::Mat image = ReadUnchanged(path, "image");
+  const std::vector<cv::Mat> rgb = RgbPlanes(image, path);
+  // BT.601 luma, as cv::cvtColor(BGR2GRAY) and COLMAP's Bitmap do.
+  if (image.channels() <= 2) return FromPlanes({rgb[0]});
+  const cv::Mat gray = 0.299f * rgb[0] + 0.587f * rgb[1] + 0.114f * rgb[2];
+  return FromPlanes({gray});
+}
+
+FloatMap ReadImageRgb(const std::string& path) {
+  const cv::Mat image = ReadUnchanged(path, "image");
+  return FromPlanes(RgbPlanes(image, path));
+}
+
+FloatMap ReadMask(const std::string& path, int width, int height) {
+  CHECK_GT(width, 0);
+  CHECK_GT(height, 0);
+  if (path.empty()) return FloatMap(width, height, 1, 1.0f);
+  const cv::Mat image = ReadUnchanged(path, "mask");
+  std::vector<cv::Mat> channels;
+  cv::split(image, channels);
+  // Grey value 0 excludes (COLMAP reads masks as grayscale); for colour masks any non-zero
+  // colour channel keeps the pixel.
+  cv::Mat keep = cv::Mat::zeros(image.rows, image.cols, CV_8U);
+  int num_colour = static_cast<int>(channels.size());
+  if (num_colour == 2 || num_colour == 4) --num_colour;  // alpha does not count
+  for (int c = 0; c < num_colour; ++c) {
+    cv::Mat nonzero = channels[c] != 0;
+    cv::bitwise_or(keep, nonzero, keep);
+  }
+  if (keep.cols != width || keep.rows != height) {
+    cv::Mat resized;
+    cv::resize(keep, resized, cv::Size(width, height), 0, 0, cv::INTER_NEAREST);
+    keep = resized;
+  }
+  THROW_IF(cv::countNonZero(keep) == 0,
+           "Mask " << path << " excludes every pixel (all zero at " << width << "x" << height
+                   << ")");
+  FloatMap map(width, height, 1, 0.0f);
+  for (int r = 0; r < height; ++r) {
+    const uint8_t* row = keep.ptr<uint8_t>(r);
+    for (int c = 0; c < width; ++c) map.At(r, c) = row[c] != 0 ? 1.0f : 0.0f;
+  }
+  return map;
+}
+
+}  // namespace hairmvs
