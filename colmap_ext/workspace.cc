@@ -206,4 +206,22 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
   return map;
 }
 
+void WriteImage(const std::string& path, const FloatMap& image) {
+  CHECK(image.Channels() == 1 || image.Channels() == 3) << image.Channels();
+  std::vector<cv::Mat> planes;
+  // OpenCV wants B, G, R.
+  for (int c = image.Channels() - 1; c >= 0; --c) {
+    cv::Mat plane(image.Height(), image.Width(), CV_32F,
+                  const_cast<float*>(image.Channel(c)));
+    cv::Mat bytes;
+    plane.convertTo(bytes, CV_8U, 255.0);  // saturating, rounding
+    planes.push_back(bytes);
+  }
+  cv::Mat merged;
+  cv::merge(planes, merged);
+  WritePathAtomically(path, [&](const std::string& tmp_path) {
+    THROW_IF(!cv::imwrite(tmp_path, merged), "Cannot write image " << path);
+  });
+}
+
 }  // namespace hairmvs

@@ -1,0 +1,153 @@
+#include "colmap_ext/workspace.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_ext/test_util.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::MakePlaneModel;
+using testing_util::MakeTestDir;
+using testing_util::WriteTestWorkspace;
+
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+TEST(Workspace, ReadsLayoutAndPaths) {
+  const std::string dir = MakeTestDir("ws");
+  const Reconstruction model = MakePlaneModel();
+  WriteTestWorkspace(dir, model);
+  std::filesystem::create_directories(JoinPaths(dir, "masks"));
+  cv::imwrite(JoinPaths(dir, "masks", "b.png.png"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
+
+  const Workspace ws = Workspace::Read(dir);
+  EXPECT_EQ(ws.ImageNames(), (std::vector<std::string>{"a.png", "b.png", "c.png"}));
+  EXPECT_EQ(ws.ImageIdx("c.png"), 2);
+  EXPECT_THROW(ws.ImageIdx("d.png"), Error);
+  EXPECT_EQ(ws.ImageByName("b.png").image_id, 2u);
+  EXPECT_EQ(ws.CameraOf("b.png").CalibrationMatrix()(0, 0), 50.0);
+  EXPECT_EQ(ws.ImagePath("a.png"), JoinPaths(dir, "images", "a.png"));
+  EXPECT_EQ(ws.DepthMapPath("a.png"), JoinPaths(dir, "stereo", "depth_maps", "a.png.geometric.bin"));
+  EXPECT_EQ(ws.NormalMapPath("a.png", "photometric"),
+            JoinPaths(dir, "stereo", "normal_maps", "a.png.photometric.bin"));
+  EXPECT_THROW(ws.DepthMapPath("a.png", "geometrical"), Error);
+  EXPECT_EQ(ws.MaskPath("a.png"), "");
+  EXPECT_EQ(ws.MaskPath("b.png"), JoinPaths(dir, "masks", "b.png.png"));
+  EXPECT_NE(ws.OrientationMapPath("a.png", 0), ws.OrientationMapPath("a.png", 1));
+
+  // An explicit mask folder; 3.12+ naming (the name itself when it ends in .png).
+  const std::string other_masks = JoinPaths(dir, "other_masks");
+  std::filesystem::create_directories(other_masks);
+  cv::imwrite(JoinPaths(other_masks, "a.png"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
+  const Workspace ws2 = Workspace::Read(dir, other_masks);
+  EXPECT_EQ(ws2.MaskPath("a.png"), JoinPaths(other_masks, "a.png"));
+  EXPECT_EQ(ws2.MaskPath("b.png"), "");
+  EXPECT_NE(ErrorOf([&] { Workspace::Read(dir, JoinPaths(dir, "nomasks")); }).find("nomasks"),
+            std::string::npos);
+}
+
+TEST(Workspace, BadWorkspaces) {
+  const std::string dir = MakeTestDir("ws_bad");
+  // Missing folder, missing sparse model.
+  EXPECT_NE(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "none")); }).find("Missing workspace"),
+            std::string::npos);
+  CreateDirs(JoinPaths(dir, "empty_dir"));
+  EXPECT_NE(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "empty_dir")); })
+                .find("Missing sparse model"),
+            std::string::npos);
+  // Empty workspace: a model without images.
+  Reconstruction empty;
+  WriteReconstruction(empty, JoinPaths(dir, "empty", "sparse"), ModelFormat::kText);
+  EXPECT_NE(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "empty")); }).find("no images"),
+            std::string::npos);
+  // Image listed but missing.
+  const std::string missing = JoinPaths(dir, "missing");
+  WriteTestWorkspace(missing, MakePlaneModel());
+  std::filesystem::remove(JoinPaths(missing, "images", "b.png"));
+  const std::string error = ErrorOf([&] { Workspace::Read(missing); });
+  EXPECT_NE(error.find("b.png"), std::string::npos) << error;
+  EXPECT_NE(error.find("missing"), std::string::npos) << error;
+  // A distorted camera: reading works, CameraOf tells the user to undistort.
+  const std::string distorted = JoinPaths(dir, "distorted");
+  Reconstruction model = MakePlaneModel();
+  model.cameras.at(1).model_id = 2;  // SIMPLE_RADIAL: f, cx, cy, k
+  model.cameras.at(1).params = {50, 32, 24, 0.01};
+  WriteTestWorkspace(distorted, model, true);
+  const Workspace ws = Workspace::Read(distorted);
+  EXPECT_NE(ErrorOf([&] { ws.CameraOf("a.png"); }).find("image_undistorter"), std::string::npos);
+}
+
+TEST(Images, GrayRgbAndSixteenBit) {
+  const std::string dir = MakeTestDir("images");
+  cv::Mat bgr(2, 3, CV_8UC3, cv::Scalar(0, 0, 0));
+  bgr.at<cv::Vec3b>(0, 1) = cv::Vec3b(0, 0, 255);    // red
+  bgr.at<cv::Vec3b>(1, 2) = cv::Vec3b(255, 0, 0);    // blue
+  const std::string path = JoinPaths(dir, "c.png");
+  ASSERT_TRUE(cv::imwrite(path, bgr));
+  const FloatMap rgb = ReadImageRgb(path);
+  ASSERT_EQ(rgb.Channels(), 3);
+  EXPECT_FLOAT_EQ(rgb.At(0, 1, 0), 1.0f);
+  EXPECT_FLOAT_EQ(rgb.At(0, 1, 2), 0.0f);
+  EXPECT_FLOAT_EQ(rgb.At(1, 2, 2), 1.0f);
+  const FloatMap gray = ReadImageGray(path);
+  ASSERT_EQ(gray.Channels(), 1);
+  EXPECT_NEAR(gray.At(0, 1), 0.299f, 1e-6);
+  EXPECT_NEAR(gray.At(1, 2), 0.114f, 1e-6);
+  EXPECT_EQ(gray.At(0, 0), 0.0f);
+
+  cv::Mat sixteen(2, 2, CV_16U, cv::Scalar(65535));
+  sixteen.at<uint16_t>(1, 0) = 32768;
+  const std::string path16 = JoinPaths(dir, "g16.png");
+  ASSERT_TRUE(cv::imwrite(path16, sixteen));
+  const FloatMap g16 = ReadImageGray(path16);
+  EXPECT_FLOAT_EQ(g16.At(0, 0), 1.0f);
+  EXPECT_NEAR(g16.At(1, 0), 32768.0 / 65535.0, 1e-6);
+
+  // WriteImage / ReadImageRgb round trip within 8-bit quantisation.
+  FloatMap picture(5, 4, 3);
+  for (size_t i = 0; i < picture.Data().size(); ++i) picture.Data()[i] = (i % 11) / 10.0f;
+  WriteImage(JoinPaths(dir, "w.png"), picture);
+  const FloatMap back = ReadImageRgb(JoinPaths(dir, "w.png"));
+  for (size_t i = 0; i < picture.Data().size(); ++i) {
+    EXPECT_NEAR(back.Data()[i], picture.Data()[i], 0.5 / 255 + 1e-6);
+  }
+  EXPECT_NE(ErrorOf([&] { ReadImageGray(JoinPaths(dir, "none.png")); }).find("none.png"),
+            std::string::npos);
+  WriteFileAtomically(JoinPaths(dir, "junk.png"), [](std::ostream& out) { out << "junk"; });
+  EXPECT_NE(ErrorOf([&] { ReadImageGray(JoinPaths(dir, "junk.png")); }).find("junk.png"),
+            std::string::npos);
+}
+
+TEST(Images, MaskResizedNearestAndAllZeroIsAnError) {
+  const std::string dir = MakeTestDir("masks");
+  cv::Mat mask(2, 2, CV_8U, cv::Scalar(0));
+  mask.at<uint8_t>(0, 1) = 255;
+  const std::string path = JoinPaths(dir, "m.png");
+  ASSERT_TRUE(cv::imwrite(path, mask));
+  const FloatMap m = ReadMask(path, 4, 4);
+  EXPECT_EQ(m.At(0, 3), 1.0f);
+  EXPECT_EQ(m.At(1, 2), 1.0f);
+  EXPECT_EQ(m.At(0, 0), 0.0f);
+  EXPECT_EQ(m.At(3, 3), 0.0f);
+  const FloatMap ones = ReadMask("", 3, 2);
+  EXPECT_EQ(ones.Data(), std::vector<float>(6, 1.0f));
+  const std::string zero = JoinPaths(dir, "zero.png");
+  ASSERT_TRUE(cv::imwrite(zero, cv::Mat(3, 3, CV_8U, cv::Scalar(0))));
+  EXPECT_NE(ErrorOf([&] { ReadMask(zero, 3, 3); }).find("zero.png"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hairmvs
