@@ -1,0 +1,137 @@
+#include "src/evaluation/ground_truth.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <random>
+
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+std::string TestDir(const std::string& name) {
+  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_gt_" + name);
+  std::filesystem::remove_all(dir);
+  CreateDirs(dir);
+  return dir;
+}
+
+// Curved strands with points ~6 mm apart, like the shared sets.
+GroundTruthStrands TestStrands() {
+  GroundTruthStrands strands;
+  strands.offsets.push_back(0);
+  for (int s = 0; s < 6; ++s) {
+    const int n = (s == 5) ? 1 : 8 + s;  // the last strand is a single point
+    for (int k = 0; k < n; ++k) {
+      const double a = 0.15 * k + s;
+      strands.points.emplace_back(0.01f * s + 0.02f * std::cos(a), 0.02f * std::sin(a),
+                                  0.006f * k);
+    }
+    strands.offsets.push_back(strands.points.size());
+  }
+  return strands;
+}
+
+// Brute force: the minimum over a very fine sampling of every spline segment.
+double BruteForceDistance(const GroundTruthStrands& strands, const Eigen::Vector3d& x) {
+  double best = std::numeric_limits<double>::infinity();
+  for (size_t s = 0; s < strands.NumStrands(); ++s) {
+    const int64_t b = strands.offsets[s], n = strands.offsets[s + 1] - b;
+    auto p = [&](int64_t k) {
+      return strands.points[b + std::clamp<int64_t>(k, 0, n - 1)].cast<double>();
+    };
+    if (n == 1) best = std::min(best, (p(0) - x).norm());
+    for (int64_t k = 0; k + 1 < n; ++k) {
+      for (int j = 0; j <= 20000; ++j) {
+        const Eigen::Vector3d c = CatmullRom(p(k - 1), p(k), p(k + 1), p(k + 2), j / 20000.0);
+        best = std::min(best, (c - x).norm());
+      }
+    }
+  }
+  return best;
+}
+
+TEST(GroundTruth, CatmullRomInterpolates) {
+  const Eigen::Vector3d p0(0, 0, 0), p1(1, 0, 0), p2(2, 1, 0), p3(3, 3, 1);
+  EXPECT_TRUE(CatmullRom(p0, p1, p2, p3, 0.0).isApprox(p1));
+  EXPECT_TRUE(CatmullRom(p0, p1, p2, p3, 1.0).isApprox(p2));
+  // On collinear equally spaced points the uniform spline is the line itself.
+  const Eigen::Vector3d mid = CatmullRom(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 1, 1),
+                                         Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(3, 3, 3), 0.5);
+  EXPECT_TRUE(mid.isApprox(Eigen::Vector3d(1.5, 1.5, 1.5)));
+}
+
+TEST(GroundTruth, StrandDistanceMatchesBruteForce) {
+  const GroundTruthStrands strands = TestStrands();
+  const StrandDistance distance(strands, 2e-4);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-0.03, 0.09);
+  std::uniform_real_distribution<double> noise(-1e-3, 1e-3);
+  std::vector<Eigen::Vector3d> queries;
+  for (int i = 0; i < 40; ++i) queries.emplace_back(u(rng), u(rng) * 0.5, u(rng) * 0.6);
+  // Points close to the strands, where the spline-vs-polyline difference matters.
+  for (int i = 0; i < 40; ++i) {
+    const Eigen::Vector3f& p = strands.points[i % strands.points.size()];
+    queries.push_back(p.cast<double>() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
+  }
+  const std::vector<double> batch = distance.Distances(queries);
+  for (size_t i = 0; i < queries.size(); ++i) {
+    const double expected = BruteForceDistance(strands, queries[i]);
+    EXPECT_NEAR(distance.Distance(queries[i]), expected, 1e-6) << i;
+    EXPECT_EQ(batch[i], distance.Distance(queries[i]));
+  }
+  // Sample spacing respected: at least length / spacing samples.
+  EXPECT_GT(distance.NumSamples(), 5u * 0.006 / 2e-4);
+  // A stored point is on its strand.
+  EXPECT_NEAR(distance.Distance(strands.points[3].cast<double>()), 0.0, 1e-7);
+}
+
+TEST(GroundTruth, FilesRoundTrip) {
+  const std::string dir = TestDir("files");
+  GroundTruthView view;
+  view.depth = FloatMap(5, 4, 1, 0.0f);
+  view.label.assign(20, kLabelBackground);
+  view.depth.At(1, 2) = 0.61f;
+  view.label[1 * 5 + 2] = kLabelHair;
+  WriteGroundTruthView(dir, "v0.png", view);
+  EXPECT_TRUE(ExistsFile(JoinPaths(dir, "v0.npz")));
+  const GroundTruthView back = ReadGroundTruthView(dir, "v0.png");
+  EXPECT_EQ(back.depth.Width(), 5);
+  EXPECT_EQ(back.depth.Height(), 4);
+  EXPECT_EQ(back.depth.At(1, 2), 0.61f);
+  EXPECT_EQ(back.label, view.label);
+  EXPECT_THROW(ReadGroundTruthView(dir, "v1.png"), Error);
+
+  GroundTruthCameras cameras;
+  cameras.names = {"v0.png", "v1.png"};
+  cameras.R = {Eigen::Matrix3d::Identity(),
+               Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY()).toRotationMatrix()};
+  cameras.t = {Eigen::Vector3d(0, 0, 0.6), Eigen::Vector3d(0.1, 0, 0.6)};
+  cameras.K << 100, 0, 2.5, 0, 100, 2, 0, 0, 1;
+  cameras.width = 5;
+  cameras.height = 4;
+  WriteGroundTruthCameras(dir, cameras);
+  const GroundTruthCameras cameras_back = ReadGroundTruthCameras(dir);
+  EXPECT_EQ(cameras_back.names, cameras.names);
+  EXPECT_TRUE(cameras_back.R[1].isApprox(cameras.R[1]));
+  EXPECT_TRUE(cameras_back.t[1].isApprox(cameras.t[1]));
+  EXPECT_TRUE(cameras_back.K.isApprox(cameras.K));
+  EXPECT_EQ(cameras_back.width, 5);
+  EXPECT_EQ(cameras_back.Find("v1.png"), 1);
+  EXPECT_EQ(cameras_back.Find("v9.png"), -1);
+
+  const GroundTruthStrands strands = TestStrands();
+  WriteGroundTruthStrands(dir, strands);
+  const GroundTruthStrands strands_back = ReadGroundTruthStrands(dir);
+  EXPECT_EQ(strands_back.offsets, strands.offsets);
+  ASSERT_EQ(strands_back.points.size(), strands.points.size());
+  EXPECT_EQ(strands_back.points[7], strands.points[7]);
+}
+
+}  // namespace
+}  // namespace hairmvs

@@ -1,0 +1,56 @@
+// Checks on the shared data sets' ground truth (skipped when they are absent).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+
+#include "src/core/depth_geometry.h"
+#include "src/core/file_util.h"
+#include "src/core/timer.h"
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace {
+
+double Median(std::vector<double> v) {
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// The data set's own self-check (gt/verify.json, A_depth_to_strand_spline_mm: median 0.059 mm):
+// hair pixels back-projected with their true depth lie on the rendered tubes around the
+// Catmull-Rom centrelines, so within a strand radius (0.04-0.08 mm) of them. Reproducing it
+// checks BackProjectPixel's pixel convention, the camera files and the spline densification.
+TEST(GroundTruthData, HairPixelsLieOnTheStrands) {
+  const std::string gt = JoinPaths(HAIRMVS_SHARED_DATA_DIR, "synth_straight_gantry", "gt");
+  if (!ExistsFile(JoinPaths(gt, "strands_points.npy"))) GTEST_SKIP() << "no data at " << gt;
+  Timer timer;
+  const GroundTruthStrands strands = ReadGroundTruthStrands(gt);
+  const StrandDistance distance(strands);
+  LOG(INFO) << "StrandDistance: " << distance.NumSamples() << " samples in "
+            << timer.ElapsedSeconds() << " s";
+  const GroundTruthCameras cameras = ReadGroundTruthCameras(gt);
+  std::mt19937 rng(1);
+  for (const std::string name : {"g0_c.png", "g5_l.png"}) {
+    const int i = cameras.Find(name);
+    ASSERT_GE(i, 0);
+    const GroundTruthView view = ReadGroundTruthView(gt, name);
+    std::vector<Eigen::Vector3d> points;
+    for (int r = 0; r < view.depth.Height(); ++r) {
+      for (int c = 0; c < view.depth.Width(); ++c) {
+        if (view.label[r * view.depth.Width() + c] != kLabelHair) continue;
+        const Eigen::Vector3d x = BackProjectPixel(cameras.K, c, r, view.depth.At(r, c));
+        points.push_back(cameras.R[i].transpose() * (x - cameras.t[i]));
+      }
+    }
+    std::shuffle(points.begin(), points.end(), rng);
+    points.resize(std::min<size_t>(points.size(), 20000));
+    const double median_mm = 1e3 * Median(distance.Distances(points));
+    LOG(INFO) << name << ": median distance of hair pixels to the strands " << median_mm << " mm";
+    EXPECT_LT(median_mm, 0.07);
+    EXPECT_GT(median_mm, 0.04);  // the tube radius: not exactly on the centreline
+  }
+}
+
+}  // namespace
+}  // namespace hairmvs
