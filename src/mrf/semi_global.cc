@@ -1,0 +1,256 @@
+#include "src/mrf/semi_global.h"
+
+#include <algorithm>
+#include <limits>
+#include <string>
+
+#include "src/core/logging.h"
+#include "src/opencl/opencl_context.h"
+
+namespace hairmvs {
+namespace {
+
+// Infinite truncation is passed as FLT_MAX so that the kernel needs no special case (and does
+// not depend on how a device treats infinities under its math options).
+float FiniteTruncation(const MrfProblem& problem) {
+  return std::min(problem.truncation, std::numeric_limits<float>::max());
+}
+
+int NumPaths(int width, int height, int dx, int dy) {
+  if (dy == 0) return height;
+  if (dx == 0) return width;
+  return width + height - 1;
+}
+
+const std::vector<float>& DirectionWeights(const SemiGlobalEdgeWeights& weights, int dx, int dy) {
+  if (dy == 0) return weights.right;
+  if (dx == 0) return weights.down;
+  return dx == dy ? weights.diag : weights.anti;
+}
+
+}  // namespace
+
+std::vector<std::array<int, 2>> SemiGlobalDirections(int num_directions) {
+  CHECK(num_directions == 4 || num_directions == 8) << num_directions;
+  std::vector<std::array<int, 2>> dirs = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
+  if (num_directions == 8) {
+    dirs.insert(dirs.end(), {{1, 1}, {-1, -1}, {-1, 1}, {1, -1}});
+  }
+  return dirs;
+}
+
+SemiGlobalEdgeWeights ComputeSemiGlobalEdgeWeights(const MrfProblem& problem) {
+  const int w = problem.width;
+  const int h = problem.height;
+  const size_t n = problem.NumPixels();
+  SemiGlobalEdgeWeights out;
+  out.right = problem.weight_right.empty() ? std::vector<float>(n, 0.0f) : problem.weight_right;
+  out.down = problem.weight_down.empty() ? std::vector<float>(n, 0.0f) : problem.weight_down;
+  out.diag.assign(n, 0.0f);
+  out.anti.assign(n, 0.0f);
+  auto R = [&](int c, int r) { return out.right[static_cast<size_t>(r) * w + c]; };
+  auto D = [&](int c, int r) { return out.down[static_cast<size_t>(r) * w + c]; };
+  for (int r = 0; r + 1 < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const size_t e = static_cast<size_t>(r) * w + c;
+      if (c + 1 < w) {
+        // (c,r) -> (c+1,r+1): via (c+1,r) or via (c,r+1).
+        out.diag[e] = 0.5f * (std::min(R(c, r), D(c + 1, r)) + std::min(D(c, r), R(c, r + 1)));
+      }
+      if (c > 0) {
+        // (c,r) -> (c-1,r+1): via (c-1,r) or via (c,r+1).
+        out.anti[e] =
+            0.5f * (std::min(R(c - 1, r), D(c - 1, r)) + std::min(D(c, r), R(c - 1, r + 1)));
+      }
+    }
+  }
+  return out;
+}
+
+std::vector<int> SolveSemiGlobalCpu(const MrfProblem& problem, int num_directions) {
+  const int width = problem.width;
+  const int height = problem.height;
+  const int num_labels = problem.num_labels;
+  const size_t n = problem.NumPixels();
+  const std::vector<float> offset =
+      problem.label_offset.empty() ? std::vector<float>(n, 0.0f) : problem.label_offset;
+  const float step = problem.label_step;
+  const float truncation = FiniteTruncation(problem);
+  const SemiGlobalEdgeWeights weights = ComputeSemiGlobalEdgeWeights(problem);
+  const float* cost = problem.data_cost.data();
+  std::vector<float> sum(n * num_labels, 0.0f);
+  std::vector<float> prev(num_labels);
+  std::vector<float> cur(num_labels);
+  const float kInf = std::numeric_limits<float>::infinity();
+
+  for (const auto& dir : SemiGlobalDirections(num_directions)) {
+    const int dx = dir[0];
+    const int dy = dir[1];
+    const std::vector<float>& weight = DirectionWeights(weights, dx, dy);
+    const bool upper_is_prev = dy > 0 || (dy == 0 && dx > 0);
+    const int num_paths = NumPaths(width, height, dx, dy);
+    for (int k = 0; k < num_paths; ++k) {
+      // The path's first pixel: the same enumeration as sgm_path in kernels/mrf_sgm.cl.
+      int col;
+      int row;
+      if (dy == 0) {
+        row = k;
+        col = dx > 0 ? 0 : width - 1;
+      } else if (dx == 0) {
+        col = k;
+        row = dy > 0 ? 0 : height - 1;
+      } else if (k < width) {
+        col = k;
+        row = dy > 0 ? 0 : height - 1;
+      } else {
+        const int j = k - width + 1;
+        col = dx > 0 ? 0 : width - 1;
+        row = dy > 0 ? j : height - 1 - j;
+      }
+      size_t p = static_cast<size_t>(row) * width + col;
+      float prev_min = kInf;
+      for (int b = 0; b < num_labels; ++b) {
+        prev[b] = cost[b * n + p];
+        prev_min = std::min(prev_min, prev[b]);
+        sum[b * n + p] += prev[b];
+      }
+      float prev_offset = offset[p];
+      for (;;) {
+        col += dx;
+        row += dy;
+        if (col < 0 || col >= width || row < 0 || row >= height) break;
+        const size_t q = p;
+        p = static_cast<size_t>(row) * width + col;
+        const float w = weight[upper_is_prev ? q : p];
+        const float cur_offset = offset[p];
+        float cur_min = kInf;
+        for (int b = 0; b < num_labels; ++b) {
+          const float vp = cur_offset + static_cast<float>(b) * step;
+          float best = kInf;
+          for (int a = 0; a < num_labels; ++a) {
+            const float d = (prev_offset + static_cast<float>(a) * step) - vp;
+            const float c = prev[a] + w * std::min(d * d, truncation);
+            best = std::min(best, c);
+          }
+          cur[b] = cost[b * n + p] + (best - prev_min);
+          cur_min = std::min(cur_min, cur[b]);
+        }
+        for (int b = 0; b < num_labels; ++b) {
+          prev[b] = cur[b];
+          sum[b * n + p] += cur[b];
+        }
+        prev_min = cur_min;
+        prev_offset = cur_offset;
+      }
+    }
+  }
+
+  std::vector<int> labels(n, 0);
+  for (size_t p = 0; p < n; ++p) {
+    float best = sum[p];
+    for (int b = 1; b < num_labels; ++b) {
+      if (sum[b * n + p] < best) {
+        best = sum[b * n + p];
+        labels[p] = b;
+      }
+    }
+  }
+  return labels;
+}
+
+std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_directions,
+                                       int icm_iterations, OpenCLContext* context) {
+  CHECK(context != nullptr);
+  const int width = problem.width;
+  const int height = problem.height;
+  const int num_labels = problem.num_labels;
+  const size_t n = problem.NumPixels();
+  THROW_IF(n * num_labels > static_cast<size_t>(std::numeric_limits<int>::max()),
+           "semi_global: the cost volume (" << n << " pixels x " << num_labels
+                                            << " labels) exceeds the kernel's 32-bit indexing");
+  const std::vector<float> offset =
+      problem.label_offset.empty() ? std::vector<float>(n, 0.0f) : problem.label_offset;
+  const SemiGlobalEdgeWeights weights = ComputeSemiGlobalEdgeWeights(problem);
+
+  cl::Context& ctx = context->Context();
+  cl::CommandQueue& queue = context->Queue();
+  cl::Program& program =
+      context->Program({"mrf_sgm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
+  cl::Kernel path_kernel(program, "sgm_path");
+  cl::Kernel argmin_kernel(program, "sgm_argmin");
+
+  auto read_only = [&](const std::vector<float>& host) {
+    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, host.size() * sizeof(float),
+                      const_cast<float*>(host.data()));
+  };
+  cl::Buffer cost_buffer = read_only(problem.data_cost);
+  cl::Buffer offset_buffer = read_only(offset);
+  cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, n * num_labels * sizeof(float));
+  cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
+  queue.enqueueFillBuffer(sum_buffer, 0.0f, 0, n * num_labels * sizeof(float));
+
+  // Fixed local size (PoCL specialises kernels per local size), global size rounded up.
+  constexpr int kLocalSize = 16;
+  auto rounded = [](int count) { return (count + kLocalSize - 1) / kLocalSize * kLocalSize; };
+  // Keep each direction's weight buffer alive until the queue has finished with it.
+  std::vector<cl::Buffer> weight_buffers;
+  for (const auto& dir : SemiGlobalDirections(num_directions)) {
+    const int dx = dir[0];
+    const int dy = dir[1];
+    weight_buffers.push_back(read_only(DirectionWeights(weights, dx, dy)));
+    const int num_paths = NumPaths(width, height, dx, dy);
+    path_kernel.setArg(0, cost_buffer);
+    path_kernel.setArg(1, offset_buffer);
+    path_kernel.setArg(2, problem.label_step);
+    path_kernel.setArg(3, weight_buffers.back());
+    path_kernel.setArg(4, FiniteTruncation(problem));
+    path_kernel.setArg(5, width);
+    path_kernel.setArg(6, height);
+    path_kernel.setArg(7, dx);
+    path_kernel.setArg(8, dy);
+    path_kernel.setArg(9, num_paths);
+    path_kernel.setArg(10, sum_buffer);
+    queue.enqueueNDRangeKernel(path_kernel, cl::NullRange, cl::NDRange(rounded(num_paths)),
+                               cl::NDRange(kLocalSize));
+  }
+  argmin_kernel.setArg(0, sum_buffer);
+  argmin_kernel.setArg(1, static_cast<int>(n));
+  argmin_kernel.setArg(2, label_buffer);
+  queue.enqueueNDRangeKernel(argmin_kernel, cl::NullRange,
+                             cl::NDRange(rounded(static_cast<int>(n))), cl::NDRange(kLocalSize));
+
+  if (icm_iterations > 0) {
+    // Checkerboard ICM on the labels still on the device (kernels/mrf_icm.cl).
+    cl::Program& icm_program =
+        context->Program({"mrf_icm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
+    cl::Kernel icm_kernel(icm_program, "icm_colour");
+    cl::Buffer changed_buffer(ctx, CL_MEM_READ_WRITE, sizeof(int));
+    icm_kernel.setArg(0, cost_buffer);
+    icm_kernel.setArg(1, offset_buffer);
+    icm_kernel.setArg(2, problem.label_step);
+    icm_kernel.setArg(3, weight_buffers[0]);  // direction (1, 0): weights.right
+    icm_kernel.setArg(4, weight_buffers[2]);  // direction (0, 1): weights.down
+    icm_kernel.setArg(5, FiniteTruncation(problem));
+    icm_kernel.setArg(6, width);
+    icm_kernel.setArg(7, height);
+    icm_kernel.setArg(9, label_buffer);
+    icm_kernel.setArg(10, changed_buffer);
+    for (int sweep = 0; sweep < icm_iterations; ++sweep) {
+      queue.enqueueFillBuffer(changed_buffer, 0, 0, sizeof(int));
+      for (int colour = 0; colour < 2; ++colour) {
+        icm_kernel.setArg(8, colour);
+        queue.enqueueNDRangeKernel(icm_kernel, cl::NullRange,
+                                   cl::NDRange(rounded(static_cast<int>(n))),
+                                   cl::NDRange(kLocalSize));
+      }
+      int changed = 0;
+      queue.enqueueReadBuffer(changed_buffer, CL_TRUE, 0, sizeof(int), &changed);
+      if (!changed) break;
+    }
+  }
+  std::vector<int> labels(n);
+  queue.enqueueReadBuffer(label_buffer, CL_TRUE, 0, n * sizeof(int), labels.data());
+  return labels;
+}
+
+}  // namespace hairmvs
