@@ -1,0 +1,151 @@
+#pragma once
+// Orientation-field multi-view stereo (Luo et al. 2012, Section 3; design/method.md section 2):
+// one depth map per reference view of a COLMAP dense workspace, from the orientation fields of
+// the reference and its source views, with structure-aware aggregation (a guided filter with the
+// reference orientation field as the guide), an MRF solved coarse to fine, sub-pixel refinement
+// and a final guided filter of the depth map.
+//
+// Outputs, in COLMAP's layout: stereo/depth_maps/<name>.geometric.bin (z-depth in metres, 0 =
+// invalid), stereo/normal_maps/<name>.geometric.bin (camera frame, facing the camera),
+// stereo/confidence_maps/<name>.bin, and optionally coloured PNG pictures of both.
+
+#include <string>
+#include <vector>
+
+#include "src/core/timer.h"
+
+namespace hairmvs {
+
+// What is matched between views.
+enum class StereoCost {
+  kOrientation,  // paper Eq. 5: -Re(O_ref* O_v exp(2i(phi_ref - phi_v)))
+  kPhotometric,  // baseline: -(zero-mean NCC of colour windows), same aggregation and MRF
+};
+std::string ToString(StereoCost cost);
+bool FromString(const std::string& text, StereoCost* cost);
+
+// How the depth range is sampled into labels (the paper does not say).
+enum class DepthSampling { kDepth, kInverseDepth };
+std::string ToString(DepthSampling sampling);
+bool FromString(const std::string& text, DepthSampling* sampling);
+
+struct OrientationStereoOptions {
+  StereoCost cost = StereoCost::kOrientation;
+  // Processing resolution: the longer image side is downscaled to at most this (-1: full size).
+  // Depth maps are then smaller than the images, as COLMAP's are.
+  int max_image_size = -1;
+  // Source views per reference (stereo/patch-match.cfg and SelectSourceViews decide which).
+  int max_num_source_views = 3;
+  double min_triangulation_angle_deg = 1.0;
+  // Depth range override in metres (<= 0: ComputeDepthRange, COLMAP's rule from sparse points).
+  double depth_min = -1;
+  double depth_max = -1;
+  DepthSampling depth_sampling = DepthSampling::kInverseDepth;
+  // Labels over the full depth range (coarse stage).
+  int num_depths = 128;
+  // Orientation pyramid levels used by the data term (paper: 3).
+  int num_levels = 3;
+  // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
+  // level 0 (finest), 1, 2.
+  int window_px_level0 = 7;
+  int window_px_level1 = 11;
+  int window_px_level2 = 15;
+  // Guided filter regulariser (paper Eq. 8: eps = 0.12).
+  double guided_filter_eps = 0.12;
+  // Smoothness weight w_s = exp(-|O(p) - O(p')|^2 / (2 sigma_o^2)) (paper Eq. 3: 0.15).
+  double sigma_o = 0.15;
+  // lambda of E = E_d + lambda E_s, per squared coarse label (not given in the paper).
+  double lambda = 0.05;
+  // Truncation of the squared label difference of the smoothness term, in coarse labels
+  // (<= 0: plain quadratic, as the paper).
+  double truncation_labels = 4;
+  // MRF solver, by name (graph_cuts, semi_global, ... as src/mrf offers).
+  std::string mrf_solver = "graph_cuts";
+  int mrf_max_cycles = 3;
+  // Coarse to fine: the full label range is solved on the grid of this orientation level, then
+  // a band of fine labels around the upsampled coarse depth at full resolution. -1: single stage
+  // (full range at full resolution).
+  int coarse_level = 1;
+  int fine_num_labels = 16;
+  double fine_label_step = 0.5;  // in coarse labels
+  // Depth slices per kernel launch (memory vs launch overhead).
+  int slice_block = 8;
+  // Sub-pixel refinement (paper Eq. 9) and the final guided filter of the depth map (Eq. 10).
+  bool subpixel_refinement = true;
+  bool final_guided_filter = true;
+  // Pixels whose confidence (aggregated cost margin) is below this get depth 0.
+  double min_confidence = 0.0;
+  // Pixels whose label is at either end of the range are outside it: depth 0.
+  bool filter_range_ends = true;
+  // The epipole roll correction exp(2i(phi_ref - phi_v)) of paper Eq. 5 (off: for tests and
+  // measurements only).
+  bool roll_correction = true;
+  // Photometric cost only: NCC window (px) at every level.
+  int ncc_window_px = 7;
+  // Reuse / write stereo/orientation_maps/<name>.l<k>.bin.
+  bool reuse_orientation_maps = true;
+  bool write_orientation_maps = true;
+  bool write_png = false;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("cost", &cost, "orientation|photometric: what is matched");
+    v("max_image_size", &max_image_size, "longer side of the processing resolution (-1: full)");
+    v("max_num_source_views", &max_num_source_views, "source views per reference");
+    v("min_triangulation_angle_deg", &min_triangulation_angle_deg,
+      "source views must see the scene under at least this angle");
+    v("depth_min", &depth_min, "depth range start in metres (<= 0: from the sparse points)");
+    v("depth_max", &depth_max, "depth range end in metres (<= 0: from the sparse points)");
+    v("depth_sampling", &depth_sampling, "depth|inverse_depth: label spacing");
+    v("num_depths", &num_depths, "labels over the full depth range");
+    v("num_levels", &num_levels, "orientation pyramid levels in the data term (paper: 3)");
+    v("window_px_level0", &window_px_level0, "guided filter window at level 0 (finest), px");
+    v("window_px_level1", &window_px_level1, "guided filter window at level 1, px");
+    v("window_px_level2", &window_px_level2, "guided filter window at level 2, px");
+    v("guided_filter_eps", &guided_filter_eps, "guided filter eps (paper: 0.12)");
+    v("sigma_o", &sigma_o, "smoothness weight orientation scale (paper: 0.15)");
+    v("lambda", &lambda, "smoothness weight per squared coarse label");
+    v("truncation_labels", &truncation_labels,
+      "truncate the quadratic smoothness at this label difference (<= 0: none)");
+    v("mrf_solver", &mrf_solver, "MRF solver (graph_cuts, semi_global, ...)");
+    v("mrf_max_cycles", &mrf_max_cycles, "MRF solver cycles / iterations");
+    v("coarse_level", &coarse_level,
+      "orientation level whose grid the full-range MRF uses (-1: single stage at full size)");
+    v("fine_num_labels", &fine_num_labels, "labels of the fine band around the coarse depth");
+    v("fine_label_step", &fine_label_step, "fine label spacing in coarse labels");
+    v("slice_block", &slice_block, "depth slices per kernel launch");
+    v("subpixel_refinement", &subpixel_refinement, "parabola sub-label refinement (Eq. 9)");
+    v("final_guided_filter", &final_guided_filter, "guided-filter the depth map (Eq. 10)");
+    v("min_confidence", &min_confidence, "depth 0 where the cost margin is below this");
+    v("filter_range_ends", &filter_range_ends, "depth 0 at the first / last label");
+    v("roll_correction", &roll_correction, "epipole roll correction of Eq. 5");
+    v("ncc_window_px", &ncc_window_px, "photometric cost: NCC window in px");
+    v("reuse_orientation_maps", &reuse_orientation_maps,
+      "read stereo/orientation_maps/*.l<k>.bin when present and of the right size");
+    v("write_orientation_maps", &write_orientation_maps,
+      "write computed orientation fields to stereo/orientation_maps/");
+    v("write_png", &write_png, "also write coloured depth and normal pictures (PNG)");
+  }
+  bool Check(std::string* error) const;
+  // Window in px of a level (levels beyond 2 reuse the level-2 window).
+  int WindowPx(int level) const;
+};
+
+struct OrientationStereoResult {
+  int num_views = 0;
+  std::vector<std::string> depth_map_paths;
+  double seconds = 0;
+  double peak_memory_mib = 0;
+  std::string BriefReport() const;
+};
+
+// Computes depth maps for `image_names` (empty: every image of the workspace). `device_spec`
+// picks the OpenCL device ("" = first GPU, else first CPU; an index; or a name substring).
+// Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
+OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
+                                             const std::vector<std::string>& image_names,
+                                             const OrientationStereoOptions& options,
+                                             StageTimings* timings,
+                                             const std::string& device_spec = "");
+
+}  // namespace hairmvs

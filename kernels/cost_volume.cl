@@ -1,0 +1,189 @@
+// Cost volumes of orientation-field stereo (Luo et al. 2012, Eq. 4-5) and of the photometric
+// baseline, one launch per level and block of depth slices.
+//
+// Depth of slice k at pixel p (labels in "coarse label" units v):
+//   v = label_base[p] + (slice_begin + k) * label_step,  t = depth_a + depth_b * v,
+//   D = inverse_depth ? 1 / t : t.
+// Projection into source view j (SfM pixel convention, at the level's resolution):
+//   u = D * (Hj * (col + 0.5, row + 0.5, 1)) + bj, sample at (u.x / u.z - 0.5, u.y / u.z - 0.5).
+// view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), 0, 0 with
+// psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5.
+// view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
+// Orientation fields are planar: Re plane then Im plane (width * height each).
+// cost: [k][row][col] for k in [0, num_slices).
+
+inline float SampleDepth(float v, float depth_a, float depth_b, int inverse_depth) {
+  const float t = depth_a + depth_b * v;
+  return inverse_depth ? 1.0f / t : t;
+}
+
+// Bilinear sample of two planes at pixel coordinates (x, y) (pixel centres at integers).
+// Returns 0 (and valid = 0) outside [0, w-1] x [0, h-1].
+inline float2 Bilinear2(__global const float* plane0, __global const float* plane1, int w,
+                        int h, float x, float y, int* valid) {
+  if (!(x >= 0.0f && y >= 0.0f && x <= (float)(w - 1) && y <= (float)(h - 1))) {
+    *valid = 0;
+    return (float2)(0.0f, 0.0f);
+  }
+  *valid = 1;
+  int x0 = min((int)x, w - 2 < 0 ? 0 : w - 2);
+  int y0 = min((int)y, h - 2 < 0 ? 0 : h - 2);
+  const int x1 = min(x0 + 1, w - 1);
+  const int y1 = min(y0 + 1, h - 1);
+  const float fx = x - (float)x0;
+  const float fy = y - (float)y0;
+  const int i00 = y0 * w + x0, i01 = y0 * w + x1, i10 = y1 * w + x0, i11 = y1 * w + x1;
+  const float w00 = (1.0f - fx) * (1.0f - fy), w01 = fx * (1.0f - fy);
+  const float w10 = (1.0f - fx) * fy, w11 = fx * fy;
+  float2 r;
+  r.x = w00 * plane0[i00] + w01 * plane0[i01] + w10 * plane0[i10] + w11 * plane0[i11];
+  r.y = w00 * plane1[i00] + w01 * plane1[i01] + w10 * plane1[i10] + w11 * plane1[i11];
+  return r;
+}
+
+inline float Bilinear1(__global const float* plane, int w, int h, float x, float y) {
+  int x0 = min((int)x, w - 2 < 0 ? 0 : w - 2);
+  int y0 = min((int)y, h - 2 < 0 ? 0 : h - 2);
+  const int x1 = min(x0 + 1, w - 1);
+  const int y1 = min(y0 + 1, h - 1);
+  const float fx = x - (float)x0;
+  const float fy = y - (float)y0;
+  return (1.0f - fx) * (1.0f - fy) * plane[y0 * w + x0] + fx * (1.0f - fy) * plane[y0 * w + x1] +
+         (1.0f - fx) * fy * plane[y1 * w + x0] + fx * fy * plane[y1 * w + x1];
+}
+
+// Global size (width, height, num_slices).
+__kernel void orientation_cost(__global const float* ref, int width, int height,
+                               __global const float* source, __global const float* view_params,
+                               __global const int* view_dims, int num_views,
+                               __global const float* label_base, float label_step,
+                               int slice_begin, float depth_a, float depth_b, int inverse_depth,
+                               __global float* cost) {
+  const int col = get_global_id(0);
+  const int row = get_global_id(1);
+  const int k = get_global_id(2);
+  if (col >= width || row >= height) return;
+  const int p = row * width + col;
+  const int plane = width * height;
+  const float ore = ref[p];
+  const float oim = ref[plane + p];
+  float total = 0.0f;
+  if (ore != 0.0f || oim != 0.0f) {
+    const float v = label_base[p] + (float)(slice_begin + k) * label_step;
+    const float depth = SampleDepth(v, depth_a, depth_b, inverse_depth);
+    const float x = (float)col + 0.5f;
+    const float y = (float)row + 0.5f;
+    for (int j = 0; j < num_views; ++j) {
+      __global const float* m = view_params + 16 * j;
+      const float ux = depth * (m[0] * x + m[1] * y + m[2]) + m[9];
+      const float uy = depth * (m[3] * x + m[4] * y + m[5]) + m[10];
+      const float uz = depth * (m[6] * x + m[7] * y + m[8]) + m[11];
+      if (uz <= 0.0f) continue;
+      const int w = view_dims[4 * j];
+      const int h = view_dims[4 * j + 1];
+      __global const float* src = source + view_dims[4 * j + 2];
+      int valid;
+      const float2 o = Bilinear2(src, src + w * h, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
+      if (!valid) continue;
+      // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
+      const float re = ore * o.x + oim * o.y;
+      const float im = ore * o.y - oim * o.x;
+      total -= re * m[12] - im * m[13];
+    }
+  }
+  cost[(size_t)k * plane + p] = total;
+}
+
+// Photometric baseline, step 1: for one source view, the warped colour and the products whose
+// window means give the zero-mean NCC. Output planes per slice k (6 * num_slices planes):
+//   [6k+0..2] warped R, G, B; [6k+3] sum_c Iv_c^2; [6k+4] sum_c Ir_c Iv_c; [6k+5] valid (0/1).
+// ref_rgb, src_rgb: 3 planes each. m: this view's 16 view_params. Global (width, height, slices).
+__kernel void photometric_warp(__global const float* ref_rgb, int width, int height,
+                               __global const float* src_rgb, int src_width, int src_height,
+                               __global const float* m, __global const float* label_base,
+                               float label_step, int slice_begin, float depth_a, float depth_b,
+                               int inverse_depth, __global float* out) {
+  const int col = get_global_id(0);
+  const int row = get_global_id(1);
+  const int k = get_global_id(2);
+  if (col >= width || row >= height) return;
+  const int p = row * width + col;
+  const size_t plane = (size_t)width * height;
+  const float v = label_base[p] + (float)(slice_begin + k) * label_step;
+  const float depth = SampleDepth(v, depth_a, depth_b, inverse_depth);
+  const float x = (float)col + 0.5f;
+  const float y = (float)row + 0.5f;
+  const float ux = depth * (m[0] * x + m[1] * y + m[2]) + m[9];
+  const float uy = depth * (m[3] * x + m[4] * y + m[5]) + m[10];
+  const float uz = depth * (m[6] * x + m[7] * y + m[8]) + m[11];
+  float c[3] = {0.0f, 0.0f, 0.0f};
+  float valid = 0.0f;
+  if (uz > 0.0f) {
+    const float sx = ux / uz - 0.5f;
+    const float sy = uy / uz - 0.5f;
+    if (sx >= 0.0f && sy >= 0.0f && sx <= (float)(src_width - 1) &&
+        sy <= (float)(src_height - 1)) {
+      valid = 1.0f;
+      const int sp = src_width * src_height;
+      for (int ch = 0; ch < 3; ++ch) {
+        c[ch] = Bilinear1(src_rgb + ch * sp, src_width, src_height, sx, sy);
+      }
+    }
+  }
+  __global float* o = out + (size_t)6 * k * plane + p;
+  o[0] = c[0];
+  o[plane] = c[1];
+  o[2 * plane] = c[2];
+  o[3 * plane] = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+  o[4 * plane] = ref_rgb[p] * c[0] + ref_rgb[plane + p] * c[1] + ref_rgb[2 * plane + p] * c[2];
+  o[5 * plane] = valid;
+}
+
+// Photometric baseline, step 2: adds -NCC of one view to the cost block, from the window means
+// of the warp planes (box-filtered photometric_warp output) and of the reference:
+// ref_stats: [0..2] mean R, G, B; [3] mean sum_c Ir_c^2. Windows with any invalid sample add 0.
+// Global (width, height, slices).
+__kernel void photometric_accumulate(__global const float* ref_stats,
+                                     __global const float* warp_means, int width, int height,
+                                     __global float* cost) {
+  const int col = get_global_id(0);
+  const int row = get_global_id(1);
+  const int k = get_global_id(2);
+  if (col >= width || row >= height) return;
+  const int p = row * width + col;
+  const size_t plane = (size_t)width * height;
+  __global const float* w = warp_means + (size_t)6 * k * plane + p;
+  if (w[5 * plane] < 0.999f) return;
+  float mean_rr = ref_stats[3 * plane + p], mean_vv = w[3 * plane];
+  float cross = w[4 * plane];
+  for (int ch = 0; ch < 3; ++ch) {
+    const float mr = ref_stats[ch * plane + p];
+    const float mv = w[ch * plane];
+    cross -= mr * mv;
+    mean_rr -= mr * mr;
+    mean_vv -= mv * mv;
+  }
+  const float denom = sqrt(max(mean_rr, 0.0f) * max(mean_vv, 0.0f));
+  const float ncc = denom > 1e-6f ? cross / denom : 0.0f;
+  cost[(size_t)k * plane + p] -= ncc;
+}
+
+// Adds `scale` times a block of slices at (src_width, src_height), bilinearly resampled to
+// (width, height) (the same image extent; SfM pixel centres), into slices
+// [slice_offset, slice_offset + num_slices) of `volume` [slice][row][col].
+// Global (width, height, num_slices).
+__kernel void resample_accumulate(__global const float* src, int src_width, int src_height,
+                                  __global float* volume, int width, int height,
+                                  int slice_offset, float scale) {
+  const int col = get_global_id(0);
+  const int row = get_global_id(1);
+  const int k = get_global_id(2);
+  if (col >= width || row >= height) return;
+  const float sx = ((float)col + 0.5f) * (float)src_width / (float)width - 0.5f;
+  const float sy = ((float)row + 0.5f) * (float)src_height / (float)height - 0.5f;
+  const float x = clamp(sx, 0.0f, (float)(src_width - 1));
+  const float y = clamp(sy, 0.0f, (float)(src_height - 1));
+  const float value =
+      Bilinear1(src + (size_t)k * src_width * src_height, src_width, src_height, x, y);
+  volume[(size_t)(slice_offset + k) * width * height + row * width + col] += scale * value;
+}

@@ -1,0 +1,325 @@
+#include "src/stereo/cost_volume.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+#include "src/core/logging.h"
+#include "src/opencl/opencl_context.h"
+
+namespace hairmvs {
+
+namespace {
+
+cl::Program& CostProgram(OpenCLContext* context) { return context->Program({"cost_volume.cl"}); }
+
+cl::Buffer Upload(OpenCLContext* context, const void* data, size_t bytes) {
+  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                    std::max<size_t>(bytes, 4), const_cast<void*>(data));
+}
+
+// Bilinear sample with pixel centres at integers; false outside [0, w-1] x [0, h-1].
+bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double* value) {
+  const int w = map.Width(), h = map.Height();
+  if (!(x >= 0 && y >= 0 && x <= w - 1 && y <= h - 1)) return false;
+  const int x0 = std::min(static_cast<int>(x), std::max(w - 2, 0));
+  const int y0 = std::min(static_cast<int>(y), std::max(h - 2, 0));
+  const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+  const double fx = x - x0, fy = y - y0;
+  *value = (1 - fx) * (1 - fy) * map.At(y0, x0, channel) + fx * (1 - fy) * map.At(y0, x1, channel) +
+           (1 - fx) * fy * map.At(y1, x0, channel) + fx * fy * map.At(y1, x1, channel);
+  return true;
+}
+
+// Where the reference pixel (col, row) of the ref field's grid at depth D lands in the source
+// field's grid (pixel-centre coordinates), through the world frame. False behind the camera.
+bool ProjectCpu(const CostViewInput& ref, const CostViewInput& src, int col, int row,
+                double depth, double* x, double* y) {
+  const StereoCamera r = ref.camera.Scaled(ref.field.Width(), ref.field.Height());
+  const StereoCamera s = src.camera.Scaled(src.field.Width(), src.field.Height());
+  const Eigen::Vector3d ray = r.K.inverse() * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+  const Eigen::Vector3d world = r.R.transpose() * (depth * ray - r.t);
+  const Eigen::Vector3d u = s.K * (s.R * world + s.t);
+  if (u.z() <= 0) return false;
+  *x = u.x() / u.z() - 0.5;
+  *y = u.y() / u.z() - 0.5;
+  return true;
+}
+
+}  // namespace
+
+CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostViewInput& ref,
+                           const std::vector<CostViewInput>& sources, bool roll_correction,
+                           int ncc_radius)
+    : context_(context), cost_(cost), width_(ref.field.Width()), height_(ref.field.Height()),
+      num_views_(static_cast<int>(sources.size())), ncc_radius_(ncc_radius) {
+  const int expected_channels = cost == StereoCost::kOrientation ? 2 : 3;
+  CHECK_EQ(ref.field.Channels(), expected_channels);
+  ref_ = Upload(context, ref.field.Data().data(), sizeof(float) * ref.field.Data().size());
+  std::vector<float> params;
+  std::vector<int> dims;
+  std::vector<float> all_sources;
+  for (const CostViewInput& src : sources) {
+    CHECK_EQ(src.field.Channels(), expected_channels);
+    const ViewProjection projection =
+        ComputeViewProjection(ref.camera, width_, height_, src.camera, src.field.Width(),
+                              src.field.Height(), roll_correction);
+    const auto packed = projection.Packed();
+    params.insert(params.end(), packed.begin(), packed.end());
+    dims.insert(dims.end(), {src.field.Width(), src.field.Height(),
+                             static_cast<int>(all_sources.size()), 0});
+    all_sources.insert(all_sources.end(), src.field.Data().begin(), src.field.Data().end());
+    source_sizes_.push_back({src.field.Width(), src.field.Height()});
+    if (cost == StereoCost::kPhotometric) {
+      source_buffers_.push_back(
+          Upload(context, src.field.Data().data(), sizeof(float) * src.field.Data().size()));
+      source_params_.push_back(Upload(context, packed.data(), sizeof(float) * packed.size()));
+    }
+  }
+  params_ = Upload(context, params.data(), sizeof(float) * params.size());
+  dims_ = Upload(context, dims.data(), sizeof(int) * dims.size());
+  if (cost == StereoCost::kOrientation) {
+    sources_ = Upload(context, all_sources.data(), sizeof(float) * all_sources.size());
+    orientation_kernel_ = cl::Kernel(CostProgram(context), "orientation_cost");
+  } else {
+    box_ = std::make_unique<BoxFilterCL>(context);
+    warp_kernel_ = cl::Kernel(CostProgram(context), "photometric_warp");
+    accumulate_kernel_ = cl::Kernel(CostProgram(context), "photometric_accumulate");
+    // Reference window statistics: means of R, G, B and of sum_c I_c^2.
+    const size_t n = static_cast<size_t>(width_) * height_;
+    std::vector<float> planes(4 * n);
+    for (size_t p = 0; p < n; ++p) {
+      float sq = 0;
+      for (int c = 0; c < 3; ++c) {
+        const float value = ref.field.Data()[c * n + p];
+        planes[c * n + p] = value;
+        sq += value * value;
+      }
+      planes[3 * n + p] = sq;
+    }
+    cl::Buffer in = Upload(context, planes.data(), sizeof(float) * planes.size());
+    cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
+    ref_stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
+    box_->Mean(in, scratch, ref_stats_, width_, height_, 4, ncc_radius_);
+    context->Queue().finish();
+  }
+}
+
+void CostVolumeCL::Compute(const cl::Buffer& label_base, float label_step, int slice_begin,
+                           int num_slices, const DepthLabels& labels, const cl::Buffer& out) {
+  if (cost_ == StereoCost::kPhotometric) {
+    ComputePhotometric(label_base, label_step, slice_begin, num_slices, labels, out);
+    return;
+  }
+  cl::Kernel& k = orientation_kernel_;
+  int a = 0;
+  k.setArg(a++, ref_);
+  k.setArg(a++, width_);
+  k.setArg(a++, height_);
+  k.setArg(a++, sources_);
+  k.setArg(a++, params_);
+  k.setArg(a++, dims_);
+  k.setArg(a++, num_views_);
+  k.setArg(a++, label_base);
+  k.setArg(a++, label_step);
+  k.setArg(a++, slice_begin);
+  k.setArg(a++, static_cast<float>(labels.a));
+  k.setArg(a++, static_cast<float>(labels.b));
+  k.setArg(a++, static_cast<int>(labels.inverse));
+  k.setArg(a++, out);
+  context_->Queue().enqueueNDRangeKernel(k, cl::NullRange,
+                                         cl::NDRange(width_, height_, num_slices));
+}
+
+void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_step,
+                                      int slice_begin, int num_slices, const DepthLabels& labels,
+                                      const cl::Buffer& out) {
+  const size_t n = static_cast<size_t>(width_) * height_;
+  cl::CommandQueue& queue = context_->Queue();
+  queue.enqueueFillBuffer(out, 0.0f, 0, sizeof(float) * n * num_slices);
+  if (num_slices > warp_slices_) {
+    const size_t bytes = sizeof(float) * 6 * n * num_slices;
+    warp_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
+    warp_scratch_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
+    warp_means_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
+    warp_slices_ = num_slices;
+  }
+  for (int v = 0; v < num_views_; ++v) {
+    cl::Kernel& k = warp_kernel_;
+    int a = 0;
+    k.setArg(a++, ref_);
+    k.setArg(a++, width_);
+    k.setArg(a++, height_);
+    k.setArg(a++, source_buffers_[v]);
+    k.setArg(a++, source_sizes_[v][0]);
+    k.setArg(a++, source_sizes_[v][1]);
+    k.setArg(a++, source_params_[v]);
+    k.setArg(a++, label_base);
+    k.setArg(a++, label_step);
+    k.setArg(a++, slice_begin);
+    k.setArg(a++, static_cast<float>(labels.a));
+    k.setArg(a++, static_cast<float>(labels.b));
+    k.setArg(a++, static_cast<int>(labels.inverse));
+    k.setArg(a++, warp_);
+    queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width_, height_, num_slices));
+    box_->Mean(warp_, warp_scratch_, warp_means_, width_, height_, 6 * num_slices, ncc_radius_);
+    cl::Kernel& acc = accumulate_kernel_;
+    acc.setArg(0, ref_stats_);
+    acc.setArg(1, warp_means_);
+    acc.setArg(2, width_);
+    acc.setArg(3, height_);
+    acc.setArg(4, out);
+    queue.enqueueNDRangeKernel(acc, cl::NullRange, cl::NDRange(width_, height_, num_slices));
+  }
+}
+
+FloatMap CostVolumeCL::Compute(const std::vector<float>& label_base, float label_step,
+                               int slice_begin, int num_slices, const DepthLabels& labels) {
+  CHECK_EQ(label_base.size(), static_cast<size_t>(width_) * height_);
+  cl::Buffer base = Upload(context_, label_base.data(), sizeof(float) * label_base.size());
+  FloatMap out(width_, height_, num_slices);
+  cl::Buffer buffer(context_->Context(), CL_MEM_READ_WRITE, sizeof(float) * out.Data().size());
+  Compute(base, label_step, slice_begin, num_slices, labels, buffer);
+  context_->Queue().enqueueReadBuffer(buffer, CL_TRUE, 0, sizeof(float) * out.Data().size(),
+                                      out.Data().data());
+  return out;
+}
+
+FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
+                            const std::vector<float>& label_base, float label_step,
+                            int slice_begin, int num_slices, const DepthLabels& labels,
+                            bool roll_correction) {
+  const int w = ref.field.Width(), h = ref.field.Height();
+  FloatMap out(w, h, num_slices);
+  std::vector<double> psi(sources.size(), 0.0);
+  for (size_t v = 0; v < sources.size(); ++v) {
+    if (roll_correction) {
+      psi[v] = 2.0 * (EpipoleAngle(ref.camera, sources[v].camera.Center()) -
+                      EpipoleAngle(sources[v].camera, ref.camera.Center()));
+    }
+  }
+  for (int k = 0; k < num_slices; ++k) {
+    for (int row = 0; row < h; ++row) {
+      for (int col = 0; col < w; ++col) {
+        const std::complex<double> o_ref(ref.field.At(row, col, 0), ref.field.At(row, col, 1));
+        const double label = label_base[row * w + col] + (slice_begin + k) * label_step;
+        const double depth = labels.Depth(label);
+        double total = 0;
+        for (size_t v = 0; v < sources.size(); ++v) {
+          double x, y, re, im = 0;
+          if (!ProjectCpu(ref, sources[v], col, row, depth, &x, &y)) continue;
+          if (!SampleBilinear(sources[v].field, 0, x, y, &re)) continue;
+          SampleBilinear(sources[v].field, 1, x, y, &im);
+          const std::complex<double> o_src(re, im);
+          total -= (std::conj(o_ref) * o_src * std::polar(1.0, psi[v])).real();
+        }
+        out.At(row, col, k) = static_cast<float>(total);
+      }
+    }
+  }
+  return out;
+}
+
+FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
+                            const std::vector<float>& label_base, float label_step,
+                            int slice_begin, int num_slices, const DepthLabels& labels,
+                            int ncc_radius) {
+  const int w = ref.field.Width(), h = ref.field.Height();
+  FloatMap out(w, h, num_slices);
+  for (int k = 0; k < num_slices; ++k) {
+    for (size_t v = 0; v < sources.size(); ++v) {
+      // Warped source colour at every reference pixel for this slice.
+      FloatMap warped(w, h, 3);
+      std::vector<char> valid(w * h, 0);
+      for (int row = 0; row < h; ++row) {
+        for (int col = 0; col < w; ++col) {
+          const double depth =
+              labels.Depth(label_base[row * w + col] + (slice_begin + k) * label_step);
+          double x, y, value;
+          if (!ProjectCpu(ref, sources[v], col, row, depth, &x, &y)) continue;
+          if (!SampleBilinear(sources[v].field, 0, x, y, &value)) continue;
+          valid[row * w + col] = 1;
+          for (int c = 0; c < 3; ++c) {
+            SampleBilinear(sources[v].field, c, x, y, &value);
+            warped.At(row, col, c) = static_cast<float>(value);
+          }
+        }
+      }
+      for (int row = 0; row < h; ++row) {
+        for (int col = 0; col < w; ++col) {
+          // Zero-mean NCC over the clipped window, colour channels centred separately.
+          double n = 0, mr[3] = {0, 0, 0}, mv[3] = {0, 0, 0};
+          bool all_valid = true;
+          const int r0 = std::max(row - ncc_radius, 0), r1 = std::min(row + ncc_radius, h - 1);
+          const int c0 = std::max(col - ncc_radius, 0), c1 = std::min(col + ncc_radius, w - 1);
+          for (int r = r0; r <= r1; ++r) {
+            for (int q = c0; q <= c1; ++q) {
+              all_valid = all_valid && valid[r * w + q];
+              n += 1;
+              for (int c = 0; c < 3; ++c) {
+                mr[c] += ref.field.At(r, q, c);
+                mv[c] += warped.At(r, q, c);
+              }
+            }
+          }
+          if (!all_valid) continue;
+          for (int c = 0; c < 3; ++c) mr[c] /= n, mv[c] /= n;
+          double cross = 0, rr = 0, vv = 0;
+          for (int r = r0; r <= r1; ++r) {
+            for (int q = c0; q <= c1; ++q) {
+              for (int c = 0; c < 3; ++c) {
+                const double a = ref.field.At(r, q, c) - mr[c];
+                const double b = warped.At(r, q, c) - mv[c];
+                cross += a * b;
+                rr += a * a;
+                vv += b * b;
+              }
+            }
+          }
+          const double denom = std::sqrt(rr * vv) / n;
+          out.At(row, col, k) -= static_cast<float>(denom > 1e-6 ? cross / n / denom : 0.0);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+ResampleAccumulateCL::ResampleAccumulateCL(OpenCLContext* context)
+    : context_(context), kernel_(CostProgram(context), "resample_accumulate") {}
+
+void ResampleAccumulateCL::Run(const cl::Buffer& src, int src_width, int src_height,
+                               int num_slices, const cl::Buffer& volume, int width, int height,
+                               int slice_offset, float scale) {
+  int a = 0;
+  kernel_.setArg(a++, src);
+  kernel_.setArg(a++, src_width);
+  kernel_.setArg(a++, src_height);
+  kernel_.setArg(a++, volume);
+  kernel_.setArg(a++, width);
+  kernel_.setArg(a++, height);
+  kernel_.setArg(a++, slice_offset);
+  kernel_.setArg(a++, scale);
+  context_->Queue().enqueueNDRangeKernel(kernel_, cl::NullRange,
+                                         cl::NDRange(width, height, num_slices));
+}
+
+FloatMap ResampleBilinear(const FloatMap& input, int width, int height) {
+  FloatMap out(width, height, input.Channels());
+  const int sw = input.Width(), sh = input.Height();
+  for (int c = 0; c < input.Channels(); ++c) {
+    for (int row = 0; row < height; ++row) {
+      for (int col = 0; col < width; ++col) {
+        const double x = std::clamp((col + 0.5) * sw / width - 0.5, 0.0, sw - 1.0);
+        const double y = std::clamp((row + 0.5) * sh / height - 0.5, 0.0, sh - 1.0);
+        double value = 0;
+        SampleBilinear(input, c, x, y, &value);
+        out.At(row, col, c) = static_cast<float>(value);
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace hairmvs

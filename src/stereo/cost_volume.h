@@ -1,0 +1,100 @@
+#pragma once
+// Matching-cost volumes for one reference view at one pyramid level, on the device
+// (kernels/cost_volume.cl), one launch per block of depth slices.
+//  - orientation (paper Eq. 4-5): e(p, D) = sum_v -Re(O_ref(p)* O_v(P_v(p, D)) exp(2i(phi_ref -
+//    phi_v))), O_v sampled bilinearly at the level's resolution; views where P_v(p, D) falls
+//    outside the image add nothing;
+//  - photometric baseline: e(p, D) = -sum_v NCC_v(p, D), the zero-mean NCC of the colour windows
+//    (fronto-parallel in depth-label space), O(1) per pixel with box filters.
+// Slice k of a block is label v = label_base[p] + (slice_begin + k) * label_step.
+
+#include <memory>
+#include <vector>
+
+#include "hairmvs/orientation_stereo.h"
+#include "src/core/float_map.h"
+#include "src/opencl/opencl.h"
+#include "src/stereo/guided_filter.h"
+#include "src/stereo/stereo_geometry.h"
+
+namespace hairmvs {
+
+class OpenCLContext;
+
+// A view at one level: its camera at the processing resolution (scaled to the level from the
+// field's size) and its field: orientation (2 channels) or colour (3 channels).
+struct CostViewInput {
+  StereoCamera camera;
+  FloatMap field;
+};
+
+class CostVolumeCL {
+ public:
+  CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostViewInput& ref,
+               const std::vector<CostViewInput>& sources, bool roll_correction = true,
+               int ncc_radius = 3);
+  int Width() const { return width_; }
+  int Height() const { return height_; }
+  // label_base: width * height floats on the device. out: num_slices planes.
+  void Compute(const cl::Buffer& label_base, float label_step, int slice_begin, int num_slices,
+               const DepthLabels& labels, const cl::Buffer& out);
+  // Host convenience (tests): label_base of width * height floats; returns num_slices channels.
+  FloatMap Compute(const std::vector<float>& label_base, float label_step, int slice_begin,
+                   int num_slices, const DepthLabels& labels);
+
+ private:
+  void ComputePhotometric(const cl::Buffer& label_base, float label_step, int slice_begin,
+                          int num_slices, const DepthLabels& labels, const cl::Buffer& out);
+
+  OpenCLContext* context_;
+  StereoCost cost_;
+  int width_ = 0;
+  int height_ = 0;
+  int num_views_ = 0;
+  int ncc_radius_ = 3;
+  cl::Buffer ref_;
+  cl::Buffer sources_;
+  cl::Buffer params_;
+  cl::Buffer dims_;
+  std::vector<std::array<int, 2>> source_sizes_;
+  std::vector<cl::Buffer> source_buffers_;  // photometric: one colour image per view
+  std::vector<cl::Buffer> source_params_;   // photometric: 16 floats per view
+  cl::Buffer ref_stats_;                    // photometric: window means of the reference
+  cl::Buffer warp_, warp_scratch_, warp_means_;
+  int warp_slices_ = 0;
+  std::unique_ptr<BoxFilterCL> box_;
+  cl::Kernel orientation_kernel_;
+  cl::Kernel warp_kernel_;
+  cl::Kernel accumulate_kernel_;
+};
+
+// Plain CPU references (tests): the same costs, projecting each pixel through the world frame
+// (X = R_ref^T (D K_ref^-1 x - t_ref), u = K_v (R_v X + t_v)) in double precision; photometric
+// windows summed explicitly.
+FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
+                            const std::vector<float>& label_base, float label_step,
+                            int slice_begin, int num_slices, const DepthLabels& labels,
+                            bool roll_correction = true);
+FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
+                            const std::vector<float>& label_base, float label_step,
+                            int slice_begin, int num_slices, const DepthLabels& labels,
+                            int ncc_radius);
+
+// Adds `scale` times `num_slices` planes of (src_width, src_height), bilinearly resampled to the
+// (width, height) grid covering the same image, into slices [slice_offset, ...) of `volume`.
+class ResampleAccumulateCL {
+ public:
+  explicit ResampleAccumulateCL(OpenCLContext* context);
+  void Run(const cl::Buffer& src, int src_width, int src_height, int num_slices,
+           const cl::Buffer& volume, int width, int height, int slice_offset, float scale);
+
+ private:
+  OpenCLContext* context_;
+  cl::Kernel kernel_;
+};
+
+// Bilinear resampling of every channel to width x height (same image extent, SfM centres,
+// clamped at the border): the CPU twin of resample_accumulate.
+FloatMap ResampleBilinear(const FloatMap& input, int width, int height);
+
+}  // namespace hairmvs

@@ -1,0 +1,286 @@
+#include "src/stereo/depth_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/mrf/mrf.h"
+#include "src/opencl/opencl_context.h"
+#include "src/stereo/cost_volume.h"
+#include "src/stereo/guided_filter.h"
+
+namespace hairmvs {
+
+std::vector<float> SubpixelOffsets(const std::vector<float>& volume, int num_pixels,
+                                   int num_labels, const std::vector<int>& labels) {
+  std::vector<float> offsets(num_pixels, 0.0f);
+  for (int p = 0; p < num_pixels; ++p) {
+    const int l = labels[p];
+    if (l <= 0 || l >= num_labels - 1) continue;
+    const double em = volume[static_cast<size_t>(l - 1) * num_pixels + p];
+    const double e0 = volume[static_cast<size_t>(l) * num_pixels + p];
+    const double ep = volume[static_cast<size_t>(l + 1) * num_pixels + p];
+    if (em < e0 && em <= ep) {
+      offsets[p] = -0.5f;
+    } else if (ep < e0 && ep < em) {
+      offsets[p] = 0.5f;
+    } else {
+      const double denom = em - 2 * e0 + ep;
+      if (denom > 0) {
+        offsets[p] = static_cast<float>(std::clamp(0.5 * (em - ep) / denom, -0.5, 0.5));
+      }
+    }
+  }
+  return offsets;
+}
+
+void SmoothnessWeights(const FloatMap& orientation, double lambda, double sigma_o,
+                       std::vector<float>* weight_right, std::vector<float>* weight_down) {
+  const int w = orientation.Width(), h = orientation.Height();
+  weight_right->assign(static_cast<size_t>(w) * h, 0.0f);
+  weight_down->assign(static_cast<size_t>(w) * h, 0.0f);
+  const double scale = 1.0 / (2.0 * sigma_o * sigma_o);
+  auto weight = [&](int r0, int c0, int r1, int c1) {
+    const double d0 = orientation.At(r0, c0, 0) - orientation.At(r1, c1, 0);
+    const double d1 = orientation.At(r0, c0, 1) - orientation.At(r1, c1, 1);
+    return static_cast<float>(lambda * std::exp(-(d0 * d0 + d1 * d1) * scale));
+  };
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      if (col + 1 < w) (*weight_right)[row * w + col] = weight(row, col, row, col + 1);
+      if (row + 1 < h) (*weight_down)[row * w + col] = weight(row, col, row + 1, col);
+    }
+  }
+}
+
+namespace {
+
+// Per-level machinery of one reference view.
+struct LevelPipeline {
+  std::unique_ptr<CostVolumeCL> cost;
+  std::unique_ptr<GuidedFilterCL> filter;
+  int width = 0;
+  int height = 0;
+};
+
+MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
+  MrfSolverOptions mrf;
+  THROW_IF(!FromString(options.mrf_solver, &mrf.solver),
+           "--OrientationStereo.mrf_solver: unknown solver '" << options.mrf_solver << "'");
+  mrf.max_cycles = options.mrf_max_cycles;
+  return mrf;
+}
+
+}  // namespace
+
+DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
+                               const std::vector<const StereoViewData*>& sources,
+                               const FloatMap& mask, const DepthLabels& labels,
+                               const OrientationStereoOptions& options, StageTimings* timings,
+                               Progress* progress) {
+  THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
+  THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
+  const bool photometric = options.cost == StereoCost::kPhotometric;
+  int num_levels = std::min<int>(options.num_levels, static_cast<int>(ref.orientation.size()));
+  for (const StereoViewData* src : sources) {
+    num_levels = std::min<int>(num_levels, static_cast<int>(src->orientation.size()));
+    if (photometric) num_levels = std::min<int>(num_levels, static_cast<int>(src->rgb.size()));
+  }
+  if (photometric) num_levels = std::min<int>(num_levels, static_cast<int>(ref.rgb.size()));
+  THROW_IF(num_levels < 1, "EstimateDepthMap: no common pyramid level");
+  const int width0 = ref.orientation[0].Width();
+  const int height0 = ref.orientation[0].Height();
+  cl::CommandQueue& queue = context->Queue();
+  const MrfSolverOptions mrf_options = MakeMrfOptions(options);
+
+  std::vector<LevelPipeline> levels(num_levels);
+  {
+    ScopedStageTimer timer(timings, "cost volume");
+    for (int l = 0; l < num_levels; ++l) {
+      CostViewInput ref_in{ref.camera, photometric ? ref.rgb[l] : ref.orientation[l]};
+      std::vector<CostViewInput> src_in;
+      for (const StereoViewData* src : sources) {
+        src_in.push_back({src->camera, photometric ? src->rgb[l] : src->orientation[l]});
+      }
+      levels[l].cost = std::make_unique<CostVolumeCL>(context, options.cost, ref_in, src_in,
+                                                      options.roll_correction,
+                                                      options.ncc_window_px / 2);
+      levels[l].width = ref.orientation[l].Width();
+      levels[l].height = ref.orientation[l].Height();
+    }
+  }
+  {
+    ScopedStageTimer timer(timings, "aggregation");
+    for (int l = 0; l < num_levels; ++l) {
+      levels[l].filter = std::make_unique<GuidedFilterCL>(
+          context, ref.orientation[l], options.WindowPx(l) / 2,
+          static_cast<float>(options.guided_filter_eps));
+    }
+    queue.finish();
+  }
+  ResampleAccumulateCL resample(context);
+
+  // The aggregated data term summed over levels on the grid of `grid_level`:
+  // [label][row][col] for num_labels labels v = base_l(p) + k * step.
+  auto build_volume = [&](int grid_level, int num_labels,
+                          const std::vector<std::vector<float>>& base, float step) {
+    const int gw = levels[grid_level].width, gh = levels[grid_level].height;
+    const size_t grid_pixels = static_cast<size_t>(gw) * gh;
+    std::vector<float> host(grid_pixels * num_labels);
+    cl::Buffer volume(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * host.size());
+    queue.enqueueFillBuffer(volume, 0.0f, 0, sizeof(float) * host.size());
+    const int block = std::max(1, std::min(options.slice_block, num_labels));
+    std::vector<cl::Buffer> base_buffers, blocks;
+    for (int l = 0; l < num_levels; ++l) {
+      const size_t n = static_cast<size_t>(levels[l].width) * levels[l].height;
+      CHECK_EQ(base[l].size(), n);
+      base_buffers.emplace_back(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                sizeof(float) * n, const_cast<float*>(base[l].data()));
+      blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
+    }
+    for (int s0 = 0; s0 < num_labels; s0 += block) {
+      const int ns = std::min(block, num_labels - s0);
+      for (int l = 0; l < num_levels; ++l) {
+        {
+          ScopedStageTimer timer(timings, "cost volume");
+          levels[l].cost->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
+          queue.finish();
+        }
+        ScopedStageTimer timer(timings, "aggregation");
+        levels[l].filter->Filter(blocks[l], ns, blocks[l]);
+        resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0, 1.0f);
+        queue.finish();
+      }
+    }
+    queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());
+    return host;
+  };
+
+  const double truncation = options.truncation_labels > 0
+                                ? options.truncation_labels * options.truncation_labels
+                                : std::numeric_limits<double>::infinity();
+  auto solve = [&](int grid_level, int num_labels, std::vector<float>* volume,
+                   std::vector<float> offset, float step, double* energy) {
+    ScopedStageTimer timer(timings, "MRF");
+    MrfProblem problem;
+    problem.width = levels[grid_level].width;
+    problem.height = levels[grid_level].height;
+    problem.num_labels = num_labels;
+    problem.data_cost.swap(*volume);
+    problem.label_offset = std::move(offset);
+    problem.label_step = step;
+    problem.truncation = static_cast<float>(truncation);
+    SmoothnessWeights(ref.orientation[grid_level], options.lambda, options.sigma_o,
+                      &problem.weight_right, &problem.weight_down);
+    MrfResult result = SolveMrf(problem, mrf_options, context);
+    *energy = result.energy;
+    problem.data_cost.swap(*volume);
+    return result.labels;
+  };
+
+  DepthEstimate estimate;
+  const int num_depths = labels.num_labels;
+  const bool two_stage = options.coarse_level > 0 && num_levels > 1;
+  const int coarse_level = two_stage ? std::min(options.coarse_level, num_levels - 1) : 0;
+
+  // Coarse stage: every label, on the coarse grid.
+  if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
+  std::vector<std::vector<float>> zero_base(num_levels);
+  for (int l = 0; l < num_levels; ++l) {
+    zero_base[l].assign(static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
+  }
+  std::vector<float> coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
+  if (progress != nullptr) progress->Stage("MRF (all depths)");
+  const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  const int coarse_pixels = cw * ch;
+  const std::vector<int> coarse_labels =
+      solve(coarse_level, num_depths, &coarse_volume, {}, 1.0f, &estimate.coarse_energy);
+
+  FloatMap coarse_value(cw, ch, 1);
+  FloatMap coarse_confidence(cw, ch, 1);
+  {
+    ScopedStageTimer timer(timings, "refinement");
+    const std::vector<float> offsets =
+        options.subpixel_refinement
+            ? SubpixelOffsets(coarse_volume, coarse_pixels, num_depths, coarse_labels)
+            : std::vector<float>(coarse_pixels, 0.0f);
+    for (int p = 0; p < coarse_pixels; ++p) {
+      coarse_value.Data()[p] = coarse_labels[p] + offsets[p];
+      // Confidence: how much worse the best label at least 2 labels away is.
+      const int l = coarse_labels[p];
+      float other = std::numeric_limits<float>::infinity();
+      for (int k = 0; k < num_depths; ++k) {
+        if (std::abs(k - l) >= 2) {
+          other = std::min(other, coarse_volume[static_cast<size_t>(k) * coarse_pixels + p]);
+        }
+      }
+      const float chosen = coarse_volume[static_cast<size_t>(l) * coarse_pixels + p];
+      coarse_confidence.Data()[p] = std::isfinite(other) ? other - chosen : 0.0f;
+    }
+  }
+  coarse_volume.clear();
+  coarse_volume.shrink_to_fit();
+
+  FloatMap value(width0, height0, 1);
+  if (two_stage) {
+    // Fine stage: a band of fine labels around the upsampled coarse labels, at full size.
+    const int band = options.fine_num_labels;
+    const float step = static_cast<float>(options.fine_label_step);
+    const float half = 0.5f * (band - 1) * step;
+    const float max_base = std::max(0.0f, (num_depths - 1) - (band - 1) * step);
+    std::vector<std::vector<float>> base(num_levels);
+    for (int l = 0; l < num_levels; ++l) {
+      const FloatMap up = ResampleBilinear(coarse_value, levels[l].width, levels[l].height);
+      base[l].resize(up.Data().size());
+      for (size_t p = 0; p < base[l].size(); ++p) {
+        base[l][p] = std::clamp(up.Data()[p] - half, 0.0f, max_base);
+      }
+    }
+    if (progress != nullptr) progress->Stage("cost volume and aggregation (fine band)");
+    std::vector<float> fine_volume = build_volume(0, band, base, step);
+    if (progress != nullptr) progress->Stage("MRF (fine band)");
+    const std::vector<int> fine_labels =
+        solve(0, band, &fine_volume, base[0], step, &estimate.fine_energy);
+    ScopedStageTimer timer(timings, "refinement");
+    const int n = width0 * height0;
+    const std::vector<float> offsets = options.subpixel_refinement
+                                           ? SubpixelOffsets(fine_volume, n, band, fine_labels)
+                                           : std::vector<float>(n, 0.0f);
+    for (int p = 0; p < n; ++p) {
+      value.Data()[p] = base[0][p] + (fine_labels[p] + offsets[p]) * step;
+    }
+  } else {
+    value = coarse_value;
+  }
+
+  if (progress != nullptr) progress->Stage("refinement");
+  ScopedStageTimer timer(timings, "refinement");
+  estimate.confidence = coarse_level == 0 ? coarse_confidence
+                                          : ResampleBilinear(coarse_confidence, width0, height0);
+  FloatMap depth(width0, height0, 1);
+  for (size_t p = 0; p < depth.Data().size(); ++p) {
+    depth.Data()[p] = static_cast<float>(labels.Depth(value.Data()[p]));
+  }
+  if (options.final_guided_filter) {
+    // Paper Eq. 10: the depth map filtered once more with the finest level's weights.
+    depth = levels[0].filter->Filter(depth);
+  }
+  const FloatMap mask0 = mask.Empty() ? FloatMap(width0, height0, 1, 1.0f) : mask;
+  CHECK_EQ(mask0.Width(), width0);
+  CHECK_EQ(mask0.Height(), height0);
+  for (size_t p = 0; p < depth.Data().size(); ++p) {
+    const float v = value.Data()[p];
+    bool valid = mask0.Data()[p] > 0.5f && depth.Data()[p] > 0;
+    if (options.filter_range_ends && (v < 0.5f || v > num_depths - 1.5f)) valid = false;
+    if (estimate.confidence.Data()[p] < options.min_confidence) valid = false;
+    if (!valid) depth.Data()[p] = 0.0f;
+    if (valid) ++estimate.num_valid;
+  }
+  estimate.depth = std::move(depth);
+  return estimate;
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,49 @@
+#pragma once
+// The depth map of one reference view from prepared per-level data (method.md section 2):
+// cost volumes per level and block of depth slices, guided-filter aggregation per level,
+// the levels summed on the MRF grid, the MRF solved coarse to fine, sub-pixel refinement and the
+// final guided filter. Knows nothing of workspaces or files (orientation_stereo.cc does).
+
+#include <vector>
+
+#include "hairmvs/orientation_stereo.h"
+#include "src/core/float_map.h"
+#include "src/core/timer.h"
+#include "src/stereo/stereo_geometry.h"
+
+namespace hairmvs {
+
+class OpenCLContext;
+class Progress;
+
+struct StereoViewData {
+  StereoCamera camera;                 // at the processing resolution (= level 0)
+  std::vector<FloatMap> orientation;   // per level, 2 channels (Re O, Im O)
+  std::vector<FloatMap> rgb;           // per level, 3 channels (photometric cost only)
+};
+
+struct DepthEstimate {
+  FloatMap depth;       // z-depth on the level-0 grid, 0 = invalid
+  FloatMap confidence;  // aggregated cost margin (second-best minus best), level-0 grid
+  double coarse_energy = 0;
+  double fine_energy = 0;
+  int num_valid = 0;
+};
+
+DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
+                               const std::vector<const StereoViewData*>& sources,
+                               const FloatMap& mask, const DepthLabels& labels,
+                               const OrientationStereoOptions& options, StageTimings* timings,
+                               Progress* progress = nullptr);
+
+// Paper Eq. 9: sub-label offsets (in labels, within [-0.5, 0.5]) from the costs at each pixel's
+// label and its two neighbours. volume: [label][pixel]; labels at either end get 0.
+std::vector<float> SubpixelOffsets(const std::vector<float>& volume, int num_pixels,
+                                   int num_labels, const std::vector<int>& labels);
+
+// MRF smoothness weights of paper Eq. 3: lambda * exp(-|O(p) - O(q)|^2 / (2 sigma_o^2)) for
+// q = p + x (right) and p + y (down).
+void SmoothnessWeights(const FloatMap& orientation, double lambda, double sigma_o,
+                       std::vector<float>* weight_right, std::vector<float>* weight_down);
+
+}  // namespace hairmvs

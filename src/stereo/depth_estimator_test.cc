@@ -1,0 +1,145 @@
+#include "src/stereo/depth_estimator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/opencl/opencl_context.h"
+#include "src/stereo/stereo_test_util.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::LookAtCamera;
+using testing_util::MakeStrands;
+using testing_util::Pyramid;
+using testing_util::RenderView;
+using testing_util::Surface;
+
+TEST(DepthEstimator, SubpixelOffsetsFollowEquation9) {
+  // Three pixels, five labels: a parabola with its minimum at 2.3, a minimum at the lower
+  // neighbour, and a label at the end of the range.
+  const int n = 3, L = 5;
+  std::vector<float> volume(n * L);
+  for (int l = 0; l < L; ++l) {
+    volume[l * n + 0] = static_cast<float>((l - 2.3) * (l - 2.3));
+    volume[l * n + 1] = static_cast<float>(l);
+    volume[l * n + 2] = 1.0f;
+  }
+  const std::vector<float> offsets = SubpixelOffsets(volume, n, L, {2, 2, 4});
+  EXPECT_NEAR(offsets[0], 0.3f, 1e-5);
+  EXPECT_FLOAT_EQ(offsets[1], -0.5f);
+  EXPECT_FLOAT_EQ(offsets[2], 0.0f);
+}
+
+TEST(DepthEstimator, SmoothnessWeightsFollowEquation3) {
+  FloatMap o(2, 2, 2);
+  o.At(0, 0, 0) = 1.0f;
+  o.At(0, 1, 0) = 1.0f;
+  o.At(1, 0, 0) = 0.0f;
+  std::vector<float> right, down;
+  SmoothnessWeights(o, 2.0, 0.15, &right, &down);
+  EXPECT_FLOAT_EQ(right[0], 2.0f);
+  EXPECT_NEAR(down[0], 2.0 * std::exp(-1.0 / (2 * 0.15 * 0.15)), 1e-7);
+  EXPECT_FLOAT_EQ(right[1], 0.0f);  // last column
+}
+
+struct Result {
+  double median_abs_error_m = 0;
+  double completeness = 0;
+};
+
+// Renders the views, estimates the reference's depth map, compares with the truth on pixels
+// where the truth exists.
+Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& cameras,
+                   double depth_min, double depth_max, OrientationStereoOptions options,
+                   unsigned seed) {
+  const auto strands = MakeStrands(surface, 900, surface.sphere ? 0.9 : 0.6, 0.25, seed);
+  std::vector<StereoViewData> views;
+  FloatMap true_depth;
+  for (const StereoCamera& camera : cameras) {
+    const testing_util::RenderedView view = RenderView(camera, surface, strands);
+    if (true_depth.Empty()) true_depth = view.depth;
+    views.push_back({camera, Pyramid(view.orientation, 3), {}});
+  }
+  std::vector<const StereoViewData*> sources;
+  for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
+  auto context = OpenCLContext::Create();
+  const DepthLabels labels(depth_min, depth_max, options.num_depths, true);
+  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
+                                                  labels, options, nullptr);
+  std::vector<double> errors;
+  int truth = 0;
+  for (size_t p = 0; p < true_depth.Data().size(); ++p) {
+    if (true_depth.Data()[p] <= 0) continue;
+    ++truth;
+    if (estimate.depth.Data()[p] > 0) {
+      errors.push_back(std::abs(estimate.depth.Data()[p] - true_depth.Data()[p]));
+    }
+  }
+  Result result;
+  if (!errors.empty()) {
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    result.median_abs_error_m = errors[errors.size() / 2];
+  }
+  result.completeness = truth > 0 ? static_cast<double>(errors.size()) / truth : 0;
+  return result;
+}
+
+OrientationStereoOptions TestOptions() {
+  OrientationStereoOptions options;
+  options.num_depths = 64;
+  options.mrf_max_cycles = 2;
+  return options;
+}
+
+// 96 x 72 views, f = 100 px, about 1 m away: one pixel of disparity over the 0.3 m baselines
+// is about 30 mm of depth, so the tolerances below are about 0.3 px.
+std::vector<StereoCamera> TCameras(const Eigen::Vector3d& target, double roll_rad = 0) {
+  return {LookAtCamera({0, 0, 0}, target, 100, 96, 72),
+          LookAtCamera({0.3, 0, 0}, target, 100, 96, 72, roll_rad),
+          LookAtCamera({-0.3, 0, 0}, target, 100, 96, 72),
+          LookAtCamera({0, -0.3, 0}, target, 100, 96, 72)};
+}
+
+TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
+  EXPECT_LT(result.median_abs_error_m, 0.01);
+  EXPECT_GT(result.completeness, 0.8);
+}
+
+TEST(DepthEstimator, RecoversASphereCoveredInStrands) {
+  Surface sphere;
+  sphere.sphere = true;
+  sphere.point = {0, 0, 1.2};
+  sphere.radius = 0.45;
+  const Result result = Reconstruct(sphere, TCameras({0, 0, 1}), 0.6, 1.4, TestOptions(), 2);
+  EXPECT_LT(result.median_abs_error_m, 0.01);
+  EXPECT_GT(result.completeness, 0.5);
+}
+
+TEST(DepthEstimator, EpipoleRollCorrectionIsNeededForARolledSource) {
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(0, 0, -1);
+  const Eigen::Vector3d target(0, 0, 1);
+  // A pair: the source rolled 60 degrees about its optical axis.
+  const std::vector<StereoCamera> cameras = {LookAtCamera({0, 0, 0}, target, 100, 96, 72),
+                                             LookAtCamera({0.3, 0.05, 0}, target, 100, 96, 72,
+                                                          60.0 * M_PI / 180)};
+  OrientationStereoOptions options = TestOptions();
+  const Result with = Reconstruct(plane, cameras, 0.7, 1.5, options, 3);
+  options.roll_correction = false;
+  const Result without = Reconstruct(plane, cameras, 0.7, 1.5, options, 3);
+  EXPECT_LT(with.median_abs_error_m, 0.015);
+  EXPECT_GT(without.median_abs_error_m, 3 * with.median_abs_error_m);
+  std::printf("roll 60 deg: median |error| %.4f m with the correction, %.4f m without\n",
+              with.median_abs_error_m, without.median_abs_error_m);
+}
+
+}  // namespace
+}  // namespace hairmvs

@@ -1,0 +1,379 @@
+// The workspace side of orientation stereo: options, reading views, orientation fields (reused
+// from stereo/orientation_maps/ or computed), source views and depth ranges, writing outputs.
+
+#include "hairmvs/orientation_stereo.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <list>
+#include <map>
+#include <memory>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/source_views.h"
+#include "colmap_ext/workspace.h"
+#include "hairmvs/orientation_fields.h"
+#include "src/core/depth_geometry.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/mrf/mrf.h"
+#include "src/opencl/opencl_context.h"
+#include "src/orientation/orientation_field.h"
+#include "src/stereo/depth_estimator.h"
+
+namespace hairmvs {
+
+std::string ToString(StereoCost cost) {
+  return cost == StereoCost::kOrientation ? "orientation" : "photometric";
+}
+bool FromString(const std::string& text, StereoCost* cost) {
+  if (text == "orientation") {
+    *cost = StereoCost::kOrientation;
+  } else if (text == "photometric") {
+    *cost = StereoCost::kPhotometric;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+std::string ToString(DepthSampling sampling) {
+  return sampling == DepthSampling::kDepth ? "depth" : "inverse_depth";
+}
+bool FromString(const std::string& text, DepthSampling* sampling) {
+  if (text == "depth") {
+    *sampling = DepthSampling::kDepth;
+  } else if (text == "inverse_depth") {
+    *sampling = DepthSampling::kInverseDepth;
+  } else {
+    return false;
+  }
+  return true;
+}
+
+int OrientationStereoOptions::WindowPx(int level) const {
+  if (level <= 0) return window_px_level0;
+  if (level == 1) return window_px_level1;
+  return window_px_level2;
+}
+
+bool OrientationStereoOptions::Check(std::string* error) const {
+  std::ostringstream e;
+  MrfSolverType solver;
+  if (max_image_size == 0 || max_image_size < -1) e << "max_image_size must be > 0 or -1; ";
+  if (max_num_source_views < 1) e << "max_num_source_views must be >= 1; ";
+  if (depth_min > 0 && depth_max > 0 && depth_max <= depth_min) {
+    e << "depth_max must exceed depth_min; ";
+  }
+  if (num_depths < 3) e << "num_depths must be >= 3; ";
+  if (num_levels < 1) e << "num_levels must be >= 1; ";
+  if (window_px_level0 < 1 || window_px_level1 < 1 || window_px_level2 < 1) {
+    e << "window_px_level* must be >= 1; ";
+  }
+  if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
+  if (!(sigma_o > 0)) e << "sigma_o must be > 0; ";
+  if (!(lambda >= 0)) e << "lambda must be >= 0; ";
+  if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
+  if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
+  if (coarse_level < -1) e << "coarse_level must be >= -1; ";
+  if (fine_num_labels < 3) e << "fine_num_labels must be >= 3; ";
+  if (!(fine_label_step > 0)) e << "fine_label_step must be > 0; ";
+  if (slice_block < 1) e << "slice_block must be >= 1; ";
+  if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
+  *error = e.str();
+  return error->empty();
+}
+
+std::string OrientationStereoResult::BriefReport() const {
+  std::ostringstream out;
+  out << "orientation_stereo: " << num_views << " depth maps in " << seconds
+      << " s; peak memory " << peak_memory_mib << " MiB";
+  return out.str();
+}
+
+namespace {
+
+// Processing size: the longer side at most max_image_size (COLMAP's rule: scale, round).
+void ProcessingSize(int width, int height, int max_image_size, int* out_w, int* out_h) {
+  *out_w = width;
+  *out_h = height;
+  if (max_image_size > 0 && std::max(width, height) > max_image_size) {
+    const double scale = static_cast<double>(max_image_size) / std::max(width, height);
+    *out_w = std::max(1, static_cast<int>(std::lround(width * scale)));
+    *out_h = std::max(1, static_cast<int>(std::lround(height * scale)));
+  }
+}
+
+FloatMap ResizeArea(const FloatMap& input, int width, int height) {
+  if (input.Width() == width && input.Height() == height) return input;
+  FloatMap out(width, height, input.Channels());
+  for (int c = 0; c < input.Channels(); ++c) {
+    cv::Mat src(input.Height(), input.Width(), CV_32F, const_cast<float*>(input.Channel(c)));
+    cv::Mat dst(height, width, CV_32F, out.Channel(c));
+    cv::resize(src, dst, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  }
+  return out;
+}
+
+FloatMap DownsampleRgb(const FloatMap& rgb) {
+  FloatMap out((rgb.Width() + 1) / 2, (rgb.Height() + 1) / 2, 3);
+  for (int c = 0; c < 3; ++c) {
+    for (int row = 0; row < out.Height(); ++row) {
+      for (int col = 0; col < out.Width(); ++col) {
+        double sum = 0;
+        int count = 0;
+        for (int r = 2 * row; r < std::min(2 * row + 2, rgb.Height()); ++r) {
+          for (int q = 2 * col; q < std::min(2 * col + 2, rgb.Width()); ++q) {
+            sum += rgb.At(r, q, c);
+            ++count;
+          }
+        }
+        out.At(row, col, c) = static_cast<float>(sum / count);
+      }
+    }
+  }
+  return out;
+}
+
+void WriteDepthPng(const std::string& path, const FloatMap& depth) {
+  std::vector<float> valid;
+  for (float d : depth.Data()) {
+    if (d > 0) valid.push_back(d);
+  }
+  float lo = 0, hi = 1;
+  if (!valid.empty()) {
+    std::sort(valid.begin(), valid.end());
+    lo = valid[valid.size() * 2 / 100];
+    hi = valid[valid.size() * 98 / 100];
+    if (hi <= lo) hi = lo + 1e-6f;
+  }
+  cv::Mat gray(depth.Height(), depth.Width(), CV_8U);
+  for (int row = 0; row < depth.Height(); ++row) {
+    for (int col = 0; col < depth.Width(); ++col) {
+      const float t = std::clamp((depth.At(row, col) - lo) / (hi - lo), 0.0f, 1.0f);
+      gray.at<uint8_t>(row, col) = static_cast<uint8_t>(std::lround(255 * t));
+    }
+  }
+  cv::Mat colour;
+  cv::applyColorMap(gray, colour, cv::COLORMAP_JET);
+  for (int row = 0; row < depth.Height(); ++row) {
+    for (int col = 0; col < depth.Width(); ++col) {
+      if (!(depth.At(row, col) > 0)) colour.at<cv::Vec3b>(row, col) = cv::Vec3b(0, 0, 0);
+    }
+  }
+  WritePathAtomically(path, [&](const std::string& tmp) {
+    THROW_IF(!cv::imwrite(tmp, colour), "cannot write " << path);
+  });
+}
+
+void WriteNormalPng(const std::string& path, const FloatMap& normals) {
+  cv::Mat colour(normals.Height(), normals.Width(), CV_8UC3);
+  for (int row = 0; row < normals.Height(); ++row) {
+    for (int col = 0; col < normals.Width(); ++col) {
+      cv::Vec3b& px = colour.at<cv::Vec3b>(row, col);
+      for (int c = 0; c < 3; ++c) {
+        const float n = normals.At(row, col, c);
+        // BGR order: blue = z, red = x.
+        px[2 - c] = static_cast<uint8_t>(std::lround(127.5f * (std::clamp(n, -1.0f, 1.0f) + 1)));
+      }
+      if (normals.At(row, col, 2) == 0) px = cv::Vec3b(0, 0, 0);
+    }
+  }
+  WritePathAtomically(path, [&](const std::string& tmp) {
+    THROW_IF(!cv::imwrite(tmp, colour), "cannot write " << path);
+  });
+}
+
+// Reads and caches the per-view data (camera, orientation pyramid, colour pyramid).
+class ViewLoader {
+ public:
+  ViewLoader(const Workspace& workspace, const OrientationStereoOptions& options,
+             std::shared_ptr<OpenCLContext> context, StageTimings* timings)
+      : workspace_(workspace), options_(options), context_(std::move(context)),
+        timings_(timings) {}
+
+  const StereoViewData& Load(const std::string& name) {
+    for (auto it = cache_.begin(); it != cache_.end(); ++it) {
+      if (it->first == name) {
+        cache_.splice(cache_.begin(), cache_, it);
+        return cache_.front().second;
+      }
+    }
+    StereoViewData data = Read(name);
+    cache_.emplace_front(name, std::move(data));
+    // A reference and its sources, plus the next group's, stay in memory.
+    while (cache_.size() > 12) cache_.pop_back();
+    return cache_.front().second;
+  }
+
+  FloatMap Mask(const std::string& name, int width, int height) const {
+    return ReadMask(workspace_.MaskPath(name), width, height);
+  }
+
+ private:
+  StereoViewData Read(const std::string& name) {
+    ScopedStageTimer timer(timings_, "orientation");
+    const Camera& camera = workspace_.CameraOf(name);
+    const Image& image = workspace_.ImageByName(name);
+    StereoViewData data;
+    StereoCamera full;
+    full.K = camera.CalibrationMatrix();
+    full.R = image.R();
+    full.t = image.t();
+    full.width = static_cast<int>(camera.width);
+    full.height = static_cast<int>(camera.height);
+    int w, h;
+    ProcessingSize(full.width, full.height, options_.max_image_size, &w, &h);
+    data.camera = full.Scaled(w, h);
+
+    // Expected level sizes.
+    std::vector<std::array<int, 2>> sizes = {{w, h}};
+    for (int l = 1; l < options_.num_levels; ++l) {
+      sizes.push_back({(sizes.back()[0] + 1) / 2, (sizes.back()[1] + 1) / 2});
+    }
+    bool reused = options_.reuse_orientation_maps;
+    for (int l = 0; l < options_.num_levels && reused; ++l) {
+      const std::string path = workspace_.OrientationMapPath(name, l);
+      if (!ExistsFile(path)) {
+        reused = false;
+        break;
+      }
+      FloatMap level = ReadMat(path);
+      if (level.Width() != sizes[l][0] || level.Height() != sizes[l][1] ||
+          level.Channels() != 2) {
+        reused = false;
+        break;
+      }
+      data.orientation.push_back(std::move(level));
+    }
+    FloatMap gray;
+    if (!reused) {
+      data.orientation.clear();
+      gray = ResizeArea(ReadImageGray(workspace_.ImagePath(name)), w, h);
+      const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
+      if (!computer_) {
+        OrientationFieldOptions field_options;
+        field_options.num_levels = options_.num_levels;
+        computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
+      }
+      data.orientation = computer_->Compute(gray, mask);
+      if (options_.write_orientation_maps) {
+        for (size_t l = 0; l < data.orientation.size(); ++l) {
+          WriteMat(workspace_.OrientationMapPath(name, static_cast<int>(l)), data.orientation[l]);
+        }
+      }
+    }
+    if (options_.cost == StereoCost::kPhotometric) {
+      data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
+      for (int l = 1; l < options_.num_levels; ++l) data.rgb.push_back(DownsampleRgb(data.rgb.back()));
+    }
+    return data;
+  }
+
+  const Workspace& workspace_;
+  const OrientationStereoOptions& options_;
+  std::shared_ptr<OpenCLContext> context_;
+  StageTimings* timings_;
+  std::unique_ptr<OrientationFieldComputer> computer_;
+  std::list<std::pair<std::string, StereoViewData>> cache_;
+};
+
+}  // namespace
+
+OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
+                                             const std::vector<std::string>& image_names,
+                                             const OrientationStereoOptions& options,
+                                             StageTimings* timings,
+                                             const std::string& device_spec) {
+  Timer total_timer;
+  std::string error;
+  THROW_IF(!options.Check(&error), "invalid --OrientationStereo options: " << error);
+  StageTimings local_timings;
+  if (timings == nullptr) timings = &local_timings;
+  const Workspace workspace = Workspace::Read(workspace_path);
+  std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
+  for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
+
+  SourceViewOptions source_options;
+  source_options.max_num_source_views = options.max_num_source_views;
+  source_options.min_triangulation_angle_deg = options.min_triangulation_angle_deg;
+  std::map<std::string, std::vector<std::string>> sources_of;
+  for (const SourceViewSelection& selection : SelectSourceViews(workspace, source_options)) {
+    sources_of[selection.reference] = selection.sources;
+  }
+
+  std::shared_ptr<OpenCLContext> context = OpenCLContext::Create(device_spec);
+  ViewLoader loader(workspace, options, context, timings);
+  OrientationStereoResult result;
+  Progress progress("orientation_stereo", static_cast<int>(names.size()));
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string& name = names[i];
+    progress.Start(static_cast<int>(i), name);
+    const auto it = sources_of.find(name);
+    if (it == sources_of.end() || it->second.empty()) {
+      LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
+                   << "view); no depth map written";
+      continue;
+    }
+    progress.Stage("orientation fields");
+    std::vector<std::string> source_names = it->second;
+    if (static_cast<int>(source_names.size()) > options.max_num_source_views) {
+      source_names.resize(options.max_num_source_views);
+    }
+    // Copies: the cache may evict while loading the sources.
+    const StereoViewData ref = loader.Load(name);
+    std::vector<StereoViewData> source_data;
+    for (const std::string& source : source_names) source_data.push_back(loader.Load(source));
+    std::vector<const StereoViewData*> sources;
+    for (const StereoViewData& s : source_data) sources.push_back(&s);
+
+    double depth_min = options.depth_min, depth_max = options.depth_max;
+    if (depth_min <= 0 || depth_max <= 0) {
+      const DepthRange range =
+          ComputeDepthRange(workspace.Model(), workspace.ImageByName(name).image_id);
+      if (depth_min <= 0) depth_min = range.min_m;
+      if (depth_max <= 0) depth_max = range.max_m;
+    }
+    THROW_IF(!(depth_min > 0 && depth_max > depth_min),
+             name << ": no depth range (too few sparse points seen by this view?); give "
+                  << "--OrientationStereo.depth_min and depth_max");
+    const DepthLabels labels(depth_min, depth_max, options.num_depths,
+                             options.depth_sampling == DepthSampling::kInverseDepth);
+    const FloatMap mask =
+        loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
+    const DepthEstimate estimate =
+        EstimateDepthMap(context.get(), ref, sources, mask, labels, options, timings, &progress);
+
+    progress.Stage("writing");
+    ScopedStageTimer timer(timings, "writing");
+    const std::string depth_path = workspace.DepthMapPath(name, "geometric");
+    WriteMat(depth_path, estimate.depth);
+    const FloatMap normals = NormalMapFromDepthMap(estimate.depth, ref.camera.K);
+    WriteMat(workspace.NormalMapPath(name, "geometric"), normals);
+    WriteMat(workspace.ConfidenceMapPath(name), estimate.confidence);
+    if (options.write_png) {
+      WriteDepthPng(depth_path + ".png", estimate.depth);
+      WriteNormalPng(workspace.NormalMapPath(name, "geometric") + ".png", normals);
+    }
+    std::printf("  %s: %d x %d, depth %.4f-%.4f m, %d sources, %d valid pixels, "
+                "MRF energy %.4g (coarse) %.4g (fine)\n",
+                name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
+                depth_max, static_cast<int>(sources.size()), estimate.num_valid,
+                estimate.coarse_energy, estimate.fine_energy);
+    std::fflush(stdout);
+    result.depth_map_paths.push_back(depth_path);
+    ++result.num_views;
+  }
+  progress.Finish();
+  result.seconds = total_timer.ElapsedSeconds();
+  result.peak_memory_mib = PeakResidentMemoryMiB();
+  return result;
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,74 @@
+#include "src/stereo/stereo_geometry.h"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+StereoCamera StereoCamera::Scaled(int new_width, int new_height) const {
+  StereoCamera scaled = *this;
+  const double sx = static_cast<double>(new_width) / width;
+  const double sy = static_cast<double>(new_height) / height;
+  // Continuous image coordinates scale exactly in the SfM convention (the image spans [0, W]).
+  scaled.K.row(0) *= sx;
+  scaled.K.row(1) *= sy;
+  scaled.width = new_width;
+  scaled.height = new_height;
+  return scaled;
+}
+
+std::array<float, 16> ViewProjection::Packed() const {
+  std::array<float, 16> packed{};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) packed[3 * r + c] = static_cast<float>(H(r, c));
+    packed[9 + r] = static_cast<float>(b(r));
+  }
+  packed[12] = static_cast<float>(std::cos(psi_rad));
+  packed[13] = static_cast<float>(std::sin(psi_rad));
+  return packed;
+}
+
+double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_center) {
+  const Eigen::Vector3d e = camera.K * (camera.R * other_center + camera.t);
+  // (e.x / e.z - cx, e.y / e.z - cy) scaled by e.z: the sign of e.z flips the vector, which
+  // changes the angle by pi; the correction uses 2 phi, so that does not matter.
+  const double vx = e.x() - camera.K(0, 2) * e.z();
+  const double vy = e.y() - camera.K(1, 2) * e.z();
+  return std::atan2(vy, vx);
+}
+
+ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
+                                     int ref_level_height, const StereoCamera& src,
+                                     int src_level_width, int src_level_height,
+                                     bool roll_correction) {
+  const StereoCamera r = ref.Scaled(ref_level_width, ref_level_height);
+  const StereoCamera s = src.Scaled(src_level_width, src_level_height);
+  // X_src = R_rel X_ref + t_rel, X_ref = D K_r^-1 x.
+  const Eigen::Matrix3d R_rel = s.R * r.R.transpose();
+  const Eigen::Vector3d t_rel = s.t - R_rel * r.t;
+  ViewProjection projection;
+  projection.H = s.K * R_rel * r.K.inverse();
+  projection.b = s.K * t_rel;
+  if (roll_correction) {
+    projection.psi_rad =
+        2.0 * (EpipoleAngle(ref, src.Center()) - EpipoleAngle(src, ref.Center()));
+  }
+  return projection;
+}
+
+DepthLabels::DepthLabels(double depth_min_in, double depth_max_in, int num_labels_in,
+                         bool inverse_in)
+    : depth_min(depth_min_in), depth_max(depth_max_in), num_labels(num_labels_in),
+      inverse(inverse_in) {
+  CHECK_GT(depth_min, 0.0);
+  CHECK_GT(depth_max, depth_min);
+  CHECK_GE(num_labels, 2);
+  const double t0 = inverse ? 1.0 / depth_min : depth_min;
+  const double t1 = inverse ? 1.0 / depth_max : depth_max;
+  a = t0;
+  b = (t1 - t0) / (num_labels - 1);
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,66 @@
+#pragma once
+// Two-view geometry of orientation stereo: the per-view projection of a reference pixel at a
+// given depth (as a matrix and a vector, so a kernel needs no per-slice homography), the
+// epipole roll correction of paper Eq. 5, and the depth labels.
+// Pixel convention: SfM (pixel (col, row) is centred at image point (col + 0.5, row + 0.5)).
+
+#include <Eigen/Core>
+#include <array>
+
+namespace hairmvs {
+
+// A pinhole camera at the processing resolution: X_cam = R X_world + t.
+struct StereoCamera {
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  int width = 0;
+  int height = 0;
+
+  Eigen::Vector3d Center() const { return -R.transpose() * t; }
+  // The same camera for an image of width x height covering the same extent.
+  StereoCamera Scaled(int new_width, int new_height) const;
+};
+
+// u = D * H * (x, y, 1) + b maps the reference image point (x, y) of a level of size
+// (ref_level_width, ref_level_height) at z-depth D to homogeneous image coordinates of the
+// source at its level of size (src_level_width, src_level_height).
+struct ViewProjection {
+  Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  // psi = 2 (phi_ref - phi_src): multiply O_ref* O_src by exp(i psi) (paper Eq. 5).
+  double psi_rad = 0;
+  // The 16 floats the cost kernels read: H row-major, b, cos psi, sin psi, 0, 0.
+  std::array<float, 16> Packed() const;
+};
+
+ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
+                                     int ref_level_height, const StereoCamera& src,
+                                     int src_level_width, int src_level_height,
+                                     bool roll_correction = true);
+
+// Angle (radians, modulo pi is what matters) between the image +x axis and the vector from the
+// principal point of `camera` to the epipole of the camera centred at `other_center`.
+double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_center);
+
+// Depth labels: label value v in [0, num_labels - 1] (fractional values allowed) maps to
+// t = a + b v, depth = t (uniform in depth) or 1 / t (uniform in inverse depth).
+struct DepthLabels {
+  double depth_min = 0;
+  double depth_max = 0;
+  int num_labels = 0;
+  bool inverse = true;
+  double a = 0;
+  double b = 0;
+
+  DepthLabels() = default;
+  DepthLabels(double depth_min, double depth_max, int num_labels, bool inverse);
+  double Depth(double v) const {
+    const double t = a + b * v;
+    return inverse ? 1.0 / t : t;
+  }
+  // Inverse of Depth().
+  double Label(double depth) const { return ((inverse ? 1.0 / depth : depth) - a) / b; }
+};
+
+}  // namespace hairmvs
