@@ -1,0 +1,81 @@
+#pragma once
+// Orientation fields (Luo et al. 2012, Section 2; method.md section 1): for every pixel the
+// strand direction Theta (modulo pi, measured from image +x towards +y, i.e. clockwise on
+// screen) and a confidence F, stored as O = F exp(2 i Theta) so that opposite directions agree.
+// Three levels: the image, then 2x2 box-downsampled copies, filtered with the same filters.
+
+#include <string>
+#include <vector>
+
+#include "src/core/timer.h"
+
+namespace hairmvs {
+
+struct OrientationFieldOptions {
+  // Paper: 3 levels (full, 1/2, 1/4 resolution).
+  int num_levels = 3;
+  // Paper: 180 filters, 1 degree apart, theta in [0, pi).
+  int num_orientations = 180;
+  // K0(x, y) = (G_inner(x) - G_outer(x)) G_along(y): a ridge detector, narrow positive centre
+  // minus a wider surround across the strand, elongated along it (paper Section 2).
+  double sigma_across_inner_px = 0.5;
+  double sigma_across_outer_px = 1.0;
+  double sigma_along_px = 4.0;
+  // F = (max_theta |K_theta * I|)^gamma.
+  double confidence_gamma = 0.5;
+  // The sampled filter keeps the integer offsets with |along| <= t sigma_along and
+  // |across| <= t sigma_outer (a rectangle rotated with the filter); beyond 3 sigma the
+  // Gaussians are below 1.1% of their peak.
+  double truncation_sigmas = 3.0;
+  // 1: each of the two sampled 2D Gaussians (inner and outer, times G_along) is scaled to
+  // sum to 1 over the kept taps, so every sampled filter has exactly zero mean, as the
+  // continuous one has (flat regions respond 0 at every angle). 0: the plain samples of the
+  // normalised 1D Gaussians (their sums over the rotated, truncated grid vary with theta by
+  // about 1%, giving flat bright regions a small theta-dependent response).
+  bool normalize_sampled_filters = true;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("num_levels", &num_levels, "number of pyramid levels (2x2 box downsampling)");
+    v("num_orientations", &num_orientations, "number of filter angles in [0, pi)");
+    v("sigma_across_inner_px", &sigma_across_inner_px, "inner (positive) Gaussian across the strand");
+    v("sigma_across_outer_px", &sigma_across_outer_px, "outer (negative) Gaussian across the strand");
+    v("sigma_along_px", &sigma_along_px, "Gaussian along the strand");
+    v("confidence_gamma", &confidence_gamma, "F = (max |response|)^gamma");
+    v("truncation_sigmas", &truncation_sigmas,
+      "filter support: |along| <= t*sigma_along, |across| <= t*sigma_outer");
+    v("normalize_sampled_filters", &normalize_sampled_filters,
+      "scale the sampled inner/outer Gaussians to unit sum (zero-mean filters)");
+  }
+  bool Check(std::string* error) const;
+};
+
+// What `hairmvs orientation_fields` does, for a workspace.
+struct OrientationFieldsRunOptions {
+  // Empty: every image of the workspace.
+  std::vector<std::string> image_names;
+  // Also write <name>.l<k>.png: hue = strand angle, brightness = confidence (per image).
+  bool write_png = false;
+  // Masks folder (see Workspace::Read); empty = <workspace>/masks if it exists.
+  std::string mask_path;
+  // --OpenCL.device (see src/opencl/opencl_options.h).
+  std::string opencl_device;
+};
+
+struct OrientationFieldsResult {
+  int num_images = 0;
+  int num_levels = 0;
+  int num_files_written = 0;
+  double seconds = 0;
+  std::string device_name;
+  std::string BriefReport() const;
+};
+
+// Writes W/stereo/orientation_maps/<image name>.l<k>.bin (2-channel Mat: Re O, Im O) for
+// every level k. Adds the per-stage times to `timings` (may be null).
+OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
+                                             const OrientationFieldOptions& options,
+                                             const OrientationFieldsRunOptions& run_options,
+                                             StageTimings* timings);
+
+}  // namespace hairmvs

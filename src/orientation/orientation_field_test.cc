@@ -1,0 +1,192 @@
+#include "src/orientation/orientation_field.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "src/opencl/opencl_context.h"
+
+namespace hairmvs {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+
+// Absolute difference of two angles modulo 180 degrees, in [0, 90].
+double AngleDiffDeg(double a_deg, double b_deg) {
+  double d = std::fmod(std::abs(a_deg - b_deg), 180.0);
+  return std::min(d, 180.0 - d);
+}
+
+double ThetaDeg(const FloatMap& field, int row, int col) {
+  double t = 0.5 * std::atan2(field.At(row, col, 1), field.At(row, col, 0)) * kDegPerRad;
+  return t < 0 ? t + 180 : t;
+}
+
+double Confidence(const FloatMap& field, int row, int col) {
+  return std::hypot(field.At(row, col, 0), field.At(row, col, 1));
+}
+
+// Parallel lines along theta (from +x towards +y), `period_px` apart, Gaussian profile of
+// std `width_px` across; pixel (col, row) is centred at (col + 0.5, row + 0.5).
+// `across_out` receives the signed distance to the nearest line centre.
+FloatMap Stripes(int w, int h, double theta_rad, double period_px, double width_px,
+                 double background, double contrast, FloatMap* across_out = nullptr) {
+  FloatMap image(w, h, 1);
+  if (across_out != nullptr) *across_out = FloatMap(w, h, 1);
+  const double c = std::cos(theta_rad), s = std::sin(theta_rad);
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      const double x = col + 0.5 - w / 2.0, y = row + 0.5 - h / 2.0;
+      const double across = -x * s + y * c;
+      const double d = across - period_px * std::round(across / period_px);
+      image.At(row, col) =
+          static_cast<float>(background + contrast * std::exp(-0.5 * d * d / (width_px * width_px)));
+      if (across_out != nullptr) across_out->At(row, col) = static_cast<float>(d);
+    }
+  }
+  return image;
+}
+
+// Concentric bright circles around the image centre, `period_px` apart.
+FloatMap Rings(int w, int h, double period_px, double width_px, FloatMap* across_out) {
+  FloatMap image(w, h, 1);
+  *across_out = FloatMap(w, h, 1);
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      const double x = col + 0.5 - w / 2.0, y = row + 0.5 - h / 2.0;
+      const double r = std::hypot(x, y);
+      const double d = r - period_px * std::round(r / period_px);
+      image.At(row, col) =
+          static_cast<float>(0.2 + 0.6 * std::exp(-0.5 * d * d / (width_px * width_px)));
+      across_out->At(row, col) = static_cast<float>(d);
+    }
+  }
+  return image;
+}
+
+// A test image with structure at many angles and scales: noise, stripes, rings.
+FloatMap MixedImage(int w, int h, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> noise(-0.05f, 0.05f);
+  FloatMap across;
+  const FloatMap rings = Rings(w, h, 5.0, 0.8, &across);
+  const FloatMap stripes = Stripes(w, h, 0.3, 7.0, 0.7, 0.0, 0.5);
+  FloatMap image(w, h, 1);
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      const float v = col < w / 2 ? rings.At(row, col) : stripes.At(row, col) + 0.2f;
+      image.At(row, col) = std::clamp(v + noise(rng), 0.0f, 1.0f);
+    }
+  }
+  return image;
+}
+
+class OrientationFieldTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { context_ = OpenCLContext::Create(); }
+  static void TearDownTestSuite() { context_.reset(); }
+  static std::shared_ptr<OpenCLContext> context_;
+};
+std::shared_ptr<OpenCLContext> OrientationFieldTest::context_;
+
+// Compares one level of the kernel with the CPU reference: where the reference confidence is
+// above a small threshold, the confidence agrees to 1e-3 (relative) and the angle to 1 degree,
+// unless the two angles are a tie in the reference's responses (|R| within 1e-5 relative).
+void ExpectMatchesReference(const FloatMap& gray, const FloatMap& mask, const FloatMap& kernel,
+                            const OrientationFieldOptions& options, const std::string& what) {
+  const OrientationFilterBank bank(options);
+  std::vector<FloatMap> responses;
+  const FloatMap reference =
+      ComputeOrientationLevelReference(gray, mask, bank, options.confidence_gamma, &responses);
+  ASSERT_EQ(kernel.Width(), reference.Width());
+  ASSERT_EQ(kernel.Height(), reference.Height());
+  ASSERT_EQ(kernel.Channels(), 2);
+  int compared = 0, masked = 0;
+  for (int row = 0; row < gray.Height(); ++row) {
+    for (int col = 0; col < gray.Width(); ++col) {
+      if (!mask.Empty() && mask.At(row, col) <= 0) {
+        ++masked;
+        ASSERT_EQ(kernel.At(row, col, 0), 0.0f) << what << " masked " << row << "," << col;
+        ASSERT_EQ(kernel.At(row, col, 1), 0.0f) << what << " masked " << row << "," << col;
+        continue;
+      }
+      const double f_ref = Confidence(reference, row, col);
+      const double f_cl = Confidence(kernel, row, col);
+      if (f_ref < 0.02) continue;
+      ++compared;
+      ASSERT_NEAR(f_cl, f_ref, 1e-3 * f_ref) << what << " at " << row << "," << col;
+      const double diff = AngleDiffDeg(ThetaDeg(kernel, row, col), ThetaDeg(reference, row, col));
+      if (diff > 1.0 + 1e-3) {
+        const int k_cl = static_cast<int>(std::lround(ThetaDeg(kernel, row, col))) % 180;
+        const double best = std::pow(f_ref, 1.0 / options.confidence_gamma);
+        EXPECT_GE(std::abs(responses[k_cl].At(row, col)), best * (1 - 1e-5))
+            << what << ": angle " << ThetaDeg(kernel, row, col) << " vs "
+            << ThetaDeg(reference, row, col) << " at " << row << "," << col;
+      }
+    }
+  }
+  EXPECT_GT(compared, static_cast<int>(gray.NumPixels() / 4)) << what;
+  if (!mask.Empty()) {
+    EXPECT_GT(masked, 0) << what;
+  }
+}
+
+TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
+  // An odd size: row tails shorter than a vector, odd sizes at every level.
+  const FloatMap gray = MixedImage(83, 61, 7);
+  FloatMap mask(gray.Width(), gray.Height(), 1, 1.0f);
+  for (int row = 0; row < gray.Height(); ++row) {
+    for (int col = 0; col < gray.Width(); ++col) {
+      if (std::hypot(col - 60, row - 20) < 9) mask.At(row, col) = 0;
+    }
+  }
+  const OrientationFieldOptions options;
+  for (const OrientationKernelConfig& config :
+       {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
+    OrientationFieldComputer computer(context_, options, config);
+    const std::vector<FloatMap> levels = computer.Compute(gray, mask);
+    ASSERT_EQ(levels.size(), 3u);
+    FloatMap level_gray = gray, level_mask = mask;
+    for (int l = 0; l < 3; ++l) {
+      if (l > 0) {
+        level_gray = DownsampleGray(level_gray);
+        level_mask = DownsampleMask(level_mask);
+      }
+      ExpectMatchesReference(level_gray, level_mask, levels[l], options,
+                             "level " + std::to_string(l) + " vec " +
+                                 std::to_string(config.vector_width) + " block " +
+                                 std::to_string(config.block_size));
+    }
+  }
+}
+
+TEST_F(OrientationFieldTest, LevelSizesAndDownsampling) {
+  FloatMap gray(7, 5, 1);
+  for (int row = 0; row < 5; ++row) {
+    for (int col = 0; col < 7; ++col) gray.At(row, col) = static_cast<float>(row * 7 + col);
+  }
+  const FloatMap half = DownsampleGray(gray);
+  ASSERT_EQ(half.Width(), 4);
+  ASSERT_EQ(half.Height(), 3);
+  EXPECT_FLOAT_EQ(half.At(0, 0), (0 + 1 + 7 + 8) / 4.0f);
+  EXPECT_FLOAT_EQ(half.At(0, 3), (6 + 13) / 2.0f);      // odd last column
+  EXPECT_FLOAT_EQ(half.At(2, 3), 34.0f);                 // odd corner
+  FloatMap mask(7, 5, 1, 1.0f);
+  mask.At(0, 0) = mask.At(0, 1) = mask.At(1, 0) = 0;  // 3 of 4 excluded -> excluded
+  mask.At(2, 2) = 0;                                    // 1 of 4 excluded -> kept
+  const FloatMap half_mask = DownsampleMask(mask);
+  EXPECT_EQ(half_mask.At(0, 0), 0.0f);
+  EXPECT_EQ(half_mask.At(1, 1), 1.0f);
+  OrientationFieldComputer computer(context_, OrientationFieldOptions());
+  const auto levels = computer.Compute(MixedImage(37, 26, 3), FloatMap());
+  ASSERT_EQ(levels.size(), 3u);
+  EXPECT_EQ(levels[1].Width(), 19);
+  EXPECT_EQ(levels[1].Height(), 13);
+  EXPECT_EQ(levels[2].Width(), 10);
+  EXPECT_EQ(levels[2].Height(), 7);
+}
+
+}  // namespace
+}  // namespace hairmvs

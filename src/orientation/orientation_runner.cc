@@ -1,0 +1,129 @@
+// `hairmvs orientation_fields`: the orientation field of every image of a workspace.
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/workspace.h"
+#include "hairmvs/orientation_fields.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/opencl/opencl_context.h"
+#include "src/orientation/orientation_field.h"
+
+namespace hairmvs {
+namespace {
+
+// Hue = strand angle Theta in [0, pi) (OpenCV's 8-bit hue is 0..179 for 0..358 degrees, so
+// Theta in degrees maps to the full hue circle, and Theta and Theta + pi look the same);
+// brightness = confidence / (its 99th percentile over the valid pixels of this map).
+void WriteOrientationPng(const std::string& path, const FloatMap& field) {
+  const int w = field.Width(), h = field.Height();
+  std::vector<float> confidences;
+  for (size_t i = 0; i < field.NumPixels(); ++i) {
+    const float c = std::hypot(field.Channel(0)[i], field.Channel(1)[i]);
+    if (c > 0) confidences.push_back(c);
+  }
+  float scale = 1;
+  if (!confidences.empty()) {
+    const size_t nth = std::min(confidences.size() - 1, confidences.size() * 99 / 100);
+    std::nth_element(confidences.begin(), confidences.begin() + nth, confidences.end());
+    scale = confidences[nth] > 0 ? 1.0f / confidences[nth] : 1.0f;
+  }
+  cv::Mat hsv(h, w, CV_8UC3);
+  for (int r = 0; r < h; ++r) {
+    for (int c = 0; c < w; ++c) {
+      const float re = field.At(r, c, 0), im = field.At(r, c, 1);
+      double theta_deg = std::atan2(im, re) * 0.5 * 180.0 / M_PI;  // (-90, 90]
+      if (theta_deg < 0) theta_deg += 180;
+      const double value = std::min(1.0, static_cast<double>(std::hypot(re, im) * scale));
+      hsv.at<cv::Vec3b>(r, c) = cv::Vec3b(static_cast<uint8_t>(std::lround(theta_deg) % 180), 255,
+                                          static_cast<uint8_t>(std::lround(255 * value)));
+    }
+  }
+  cv::Mat bgr;
+  cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
+  WritePathAtomically(path, [&bgr](const std::string& tmp_path) {
+    THROW_IF(!cv::imwrite(tmp_path, bgr), "Could not write " << tmp_path);
+  });
+}
+
+std::string PngPathFor(const std::string& bin_path) {
+  CHECK(bin_path.size() > 4 && bin_path.compare(bin_path.size() - 4, 4, ".bin") == 0);
+  return bin_path.substr(0, bin_path.size() - 4) + ".png";
+}
+
+}  // namespace
+
+std::string OrientationFieldsResult::BriefReport() const {
+  std::ostringstream out;
+  out << "Orientation fields: " << num_images << " image(s), " << num_levels << " level(s), "
+      << num_files_written << " file(s) written in " << seconds << " s on " << device_name;
+  return out.str();
+}
+
+OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
+                                             const OrientationFieldOptions& options,
+                                             const OrientationFieldsRunOptions& run_options,
+                                             StageTimings* timings) {
+  Timer total_timer;
+  std::string error;
+  THROW_IF(!options.Check(&error), "OrientationField options: " << error);
+  Workspace workspace = [&] {
+    ScopedStageTimer timer(timings, "read workspace");
+    return Workspace::Read(workspace_path, run_options.mask_path);
+  }();
+  std::vector<std::string> names = run_options.image_names;
+  if (names.empty()) names = workspace.ImageNames();
+  for (const auto& name : names) workspace.ImageIdx(name);  // throws for an unknown name
+
+  std::shared_ptr<OpenCLContext> context;
+  std::unique_ptr<OrientationFieldComputer> computer;
+  {
+    ScopedStageTimer timer(timings, "OpenCL setup");
+    context = OpenCLContext::Create(run_options.opencl_device);
+    computer = std::make_unique<OrientationFieldComputer>(context, options);
+  }
+  computer->SetTimings(timings);
+
+  OrientationFieldsResult result;
+  result.num_levels = options.num_levels;
+  result.device_name = context->DeviceName();
+  Progress progress("orientation_fields", static_cast<int>(names.size()));
+  for (size_t i = 0; i < names.size(); ++i) {
+    const std::string& name = names[i];
+    progress.Start(static_cast<int>(i), name);
+    FloatMap gray, mask;
+    {
+      ScopedStageTimer timer(timings, "read image");
+      gray = ReadImageGray(workspace.ImagePath(name));
+      const std::string mask_path = workspace.MaskPath(name);
+      if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
+    }
+    progress.Stage("filter bank");
+    const std::vector<FloatMap> levels = computer->Compute(gray, mask);
+    progress.Stage("write");
+    ScopedStageTimer timer(timings, "write");
+    for (int l = 0; l < static_cast<int>(levels.size()); ++l) {
+      const std::string path = workspace.OrientationMapPath(name, l);
+      WriteMat(path, levels[l]);
+      ++result.num_files_written;
+      if (run_options.write_png) {
+        WriteOrientationPng(PngPathFor(path), levels[l]);
+        ++result.num_files_written;
+      }
+    }
+    ++result.num_images;
+  }
+  progress.Finish();
+  result.seconds = total_timer.ElapsedSeconds();
+  return result;
+}
+
+}  // namespace hairmvs
