@@ -1,0 +1,129 @@
+// hairmvs orientation_stereo: orientation-field depth maps of a COLMAP dense workspace.
+// hairmvs patch_match_stereo: the same, behind colmap patch_match_stereo's command line.
+
+#include <cstdio>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "hairmvs/orientation_stereo.h"
+#include "src/cli/command_registry.h"
+#include "src/core/logging.h"
+#include "src/core/option_parser.h"
+#include "src/opencl/opencl_options.h"
+
+namespace hairmvs {
+namespace {
+
+void PrintSummary(const OrientationStereoResult& result, const StageTimings& timings) {
+  std::printf("%s\n%s", result.BriefReport().c_str(), timings.Table().c_str());
+  std::printf("Peak resident memory: %.1f MiB\n", PeakResidentMemoryMiB());
+}
+
+int RunOrientationStereoCommand(int argc, char** argv) {
+  std::string workspace_path;
+  std::vector<std::string> image_names;
+  bool write_png = false;
+  OrientationStereoOptions options;
+  OpenCLOptions opencl_options;
+  OptionParser parser("orientation_stereo",
+                      "Depth maps of a COLMAP dense workspace from orientation fields (Luo et al. "
+                      "2012, Section 3): writes stereo/depth_maps/<name>.geometric.bin, "
+                      "stereo/normal_maps/<name>.geometric.bin and stereo/confidence_maps/.");
+  parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
+  parser.Add("image_names", &image_names,
+             "comma-separated reference images (default: all), e.g. to share a workspace "
+             "between processes");
+  parser.Add("write_png", &write_png, "also write coloured depth and normal pictures");
+  parser.AddSection("OrientationStereo", &options);
+  parser.AddSection("OpenCL", &opencl_options);
+  if (!parser.Parse(argc, argv)) return 0;
+  if (parser.WasGiven("write_png")) options.write_png = write_png;
+  std::string error;
+  THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);
+  std::printf("%s", parser.Values().c_str());
+  StageTimings timings;
+  const OrientationStereoResult result = RunOrientationStereo(
+      workspace_path, image_names, options, &timings, opencl_options.device);
+  PrintSummary(result, timings);
+  return 0;
+}
+
+// colmap patch_match_stereo's options that mean something here, mapped onto
+// OrientationStereoOptions; the others are accepted with a warning.
+int RunPatchMatchStereoCommand(int argc, char** argv) {
+  std::string workspace_path;
+  std::string workspace_format = "COLMAP";
+  std::string config_path;
+  int max_image_size = -1;
+  double depth_min = -1, depth_max = -1, min_triangulation_angle = 1.0;
+  bool geom_consistency = true, filter = true;
+  OrientationStereoOptions options;
+  OpenCLOptions opencl_options;
+  OptionParser parser("patch_match_stereo",
+                      "Drop-in for `colmap patch_match_stereo`: orientation-field depth maps in "
+                      "COLMAP's layout (stereo/depth_maps/<name>.geometric.bin), ready for "
+                      "`colmap stereo_fusion --input_type geometric`.");
+  parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
+  parser.Add("workspace_format", &workspace_format, "COLMAP (PMVS is not supported)");
+  parser.Add("PatchMatchStereo.max_image_size", &max_image_size,
+             "longer side of the processing resolution (-1: full)");
+  parser.Add("PatchMatchStereo.depth_min", &depth_min, "depth range start (-1: sparse points)");
+  parser.Add("PatchMatchStereo.depth_max", &depth_max, "depth range end (-1: sparse points)");
+  parser.Add("PatchMatchStereo.min_triangulation_angle", &min_triangulation_angle,
+             "source views: minimum triangulation angle in degrees");
+  parser.Add("PatchMatchStereo.geom_consistency", &geom_consistency,
+             "accepted; hairmvs always writes the .geometric maps that stereo_fusion reads");
+  parser.Add("PatchMatchStereo.filter", &filter,
+             "drop low-confidence pixels and pixels at the ends of the depth range");
+  parser.AddSection("OrientationStereo", &options);
+  parser.AddSection("OpenCL", &opencl_options);
+  const std::string kPatchMatchOnly = "PatchMatch-specific; orientation stereo has no such setting";
+  for (const char* name :
+       {"PatchMatchStereo.window_radius", "PatchMatchStereo.window_step",
+        "PatchMatchStereo.sigma_spatial", "PatchMatchStereo.sigma_color",
+        "PatchMatchStereo.num_samples", "PatchMatchStereo.ncc_sigma",
+        "PatchMatchStereo.incident_angle_sigma", "PatchMatchStereo.num_iterations",
+        "PatchMatchStereo.geom_consistency_regularizer",
+        "PatchMatchStereo.geom_consistency_max_cost", "PatchMatchStereo.filter_min_ncc",
+        "PatchMatchStereo.filter_min_triangulation_angle",
+        "PatchMatchStereo.filter_min_num_consistent",
+        "PatchMatchStereo.filter_geom_consistency_max_cost",
+        "PatchMatchStereo.write_consistency_graph"}) {
+    parser.AddIgnored(name, kPatchMatchOnly);
+  }
+  parser.AddIgnored("PatchMatchStereo.gpu_index", "use --OpenCL.device to pick the device");
+  parser.AddIgnored("PatchMatchStereo.cache_size", "views are cached by count, not size");
+  parser.AddIgnored("PatchMatchStereo.allow_missing_files", "missing files are errors here");
+  parser.AddIgnored("pmvs_option_name", "only --workspace_format COLMAP is supported");
+  parser.AddIgnored("config_path", "stereo/patch-match.cfg of the workspace is used");
+  if (!parser.Parse(argc, argv)) return 0;
+  THROW_IF(workspace_format != "COLMAP",
+           "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
+  if (parser.WasGiven("PatchMatchStereo.max_image_size")) options.max_image_size = max_image_size;
+  if (parser.WasGiven("PatchMatchStereo.depth_min")) options.depth_min = depth_min;
+  if (parser.WasGiven("PatchMatchStereo.depth_max")) options.depth_max = depth_max;
+  if (parser.WasGiven("PatchMatchStereo.min_triangulation_angle")) {
+    options.min_triangulation_angle_deg = min_triangulation_angle;
+  }
+  if (!filter) {
+    options.filter_range_ends = false;
+    options.min_confidence = -std::numeric_limits<double>::infinity();
+  }
+  std::string error;
+  THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);
+  StageTimings timings;
+  const OrientationStereoResult result =
+      RunOrientationStereo(workspace_path, {}, options, &timings, opencl_options.device);
+  PrintSummary(result, timings);
+  return 0;
+}
+
+}  // namespace
+
+HAIRMVS_REGISTER_COMMAND("orientation_stereo", RunOrientationStereoCommand,
+                         "depth maps from orientation fields (paper Section 3)");
+HAIRMVS_REGISTER_COMMAND("patch_match_stereo", RunPatchMatchStereoCommand,
+                         "drop-in for colmap patch_match_stereo (orientation stereo)");
+
+}  // namespace hairmvs
