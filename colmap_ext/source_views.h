@@ -1,0 +1,134 @@
+#pragma once
+// Which source views each reference view is matched against, and per-view depth ranges.
+//
+// stereo/patch-match.cfg is honoured as COLMAP reads it (colmap-formats.md section 3): pairs of
+// lines "reference" / "sources", sources being an explicit list (`,` or `;`), `__all__`, or
+// `__auto__, N`. For `__auto__` (and for every image when there is no cfg) hairmvs does not
+// simply take COLMAP's top-N by shared sparse points: orientation matching is blind to strands
+// parallel to the epipolar lines, so the chosen set should span different epipolar directions
+// at the reference. Candidates pass COLMAP's triangulation-angle test (75th percentile >=
+// min_triangulation_angle_deg; wider than max_triangulation_angle_deg only as a last resort);
+// then a greedy choice scores each candidate by
+//   shared_points / max_shared_points * (1 + epipolar_spread_weight * spread),
+// spread = (smallest angle, modulo pi, between its epipolar direction at the reference image
+// centre and those already chosen) / (pi/2), in [0, 1]; spread = 1 for the first pick.
+// A gantry T group (paper section 3: centre with left, right and bottom views) is recognised
+// and chosen first.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/workspace.h"
+
+namespace hairmvs {
+
+struct SourceViewOptions {
+  // Upper bound on the sources of an `__auto__` problem (also caps `__auto__, N` of the cfg).
+  int max_num_source_views = 4;
+  // COLMAP's PatchMatchStereo.min_triangulation_angle: 75th percentile of the shared points'
+  // triangulation angles must reach this.
+  double min_triangulation_angle_deg = 1.0;
+  // Candidates wider than this (75th percentile) are used only when no others are left: the
+  // paper's rig has about 10 degrees between neighbours; at 60 degrees hair looks different.
+  double max_triangulation_angle_deg = 40.0;
+  // Weight of the epipolar-direction spread bonus (0 = COLMAP's ranking by shared points).
+  double epipolar_spread_weight = 2.0;
+  // Read stereo/patch-match.cfg (or config_path) when it exists.
+  bool use_config = true;
+  std::string config_path;  // "" = <workspace>/stereo/patch-match.cfg
+  // Gantry T group: epipolar directions at the reference centre within this angle of the
+  // image axes, optical axes within t_group_max_view_angle_deg of the reference's, baseline
+  // lengths within this ratio (largest / smallest) of each other.
+  double t_group_max_axis_angle_deg = 20.0;
+  double t_group_max_view_angle_deg = 30.0;
+  double t_group_max_distance_ratio = 1.5;
+  // COLMAP's PatchMatchStereo.depth_min / depth_max (metres, all images); < 0 = from the
+  // sparse points (ComputeDepthRange).
+  double depth_min = -1.0;
+  double depth_max = -1.0;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("max_num_source_views", &max_num_source_views,
+      "most source views per reference for __auto__ (caps `__auto__, N` of patch-match.cfg)");
+    v("min_triangulation_angle_deg", &min_triangulation_angle_deg,
+      "75th percentile of shared points' triangulation angles must reach this (COLMAP: 1)");
+    v("max_triangulation_angle_deg", &max_triangulation_angle_deg,
+      "candidates wider than this (75th percentile) are used only when no others are left");
+    v("epipolar_spread_weight", &epipolar_spread_weight,
+      "bonus for candidates whose epipolar direction differs from those chosen (0 = COLMAP)");
+    v("use_config", &use_config, "honour stereo/patch-match.cfg when it exists");
+    v("config_path", &config_path, "patch-match.cfg to use instead of stereo/patch-match.cfg");
+    v("t_group_max_axis_angle_deg", &t_group_max_axis_angle_deg,
+      "gantry T group: epipolar directions within this angle of the image axes");
+    v("t_group_max_view_angle_deg", &t_group_max_view_angle_deg,
+      "gantry T group: optical axes within this angle of the reference's");
+    v("t_group_max_distance_ratio", &t_group_max_distance_ratio,
+      "gantry T group: largest/smallest baseline length");
+    v("depth_min", &depth_min, "minimum depth in metres for all images (<0: from sparse points)");
+    v("depth_max", &depth_max, "maximum depth in metres for all images (<0: from sparse points)");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct SourceViewSelection {
+  std::string reference;
+  std::vector<std::string> sources;
+  std::string reason;
+  bool gantry_t_group = false;
+  // Per source (same order): shared sparse points, 75th-percentile triangulation angle (deg),
+  // and epipolar direction at the reference image centre (deg, modulo 180, from +x towards +y).
+  std::vector<int> shared_points;
+  std::vector<double> triangulation_angle_deg;
+  std::vector<double> epipolar_direction_deg;
+};
+
+// One selection per reference: the references of the cfg in its order, or every image of the
+// workspace in image_idx order when there is no cfg (or use_config is false). References
+// whose source list comes out empty are dropped, as COLMAP does. Throws hairmvs::Error for a
+// malformed cfg (naming the file and line).
+std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
+                                                   const SourceViewOptions& options);
+
+struct DepthRange {
+  double min_m = -1;
+  double max_m = -1;
+  int num_points = 0;
+};
+// COLMAP's Model::ComputeDepthRanges: depths d > 0 of the sparse points in the image's tracks,
+// sorted; [0.75 * d[floor(0.01 n)], 1.25 * d[floor(0.99 n)]]; (-1, -1) when there are none.
+DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id);
+// The depth range to use: options.depth_min / depth_max when both are set (> 0), else
+// ComputeDepthRange. Throws hairmvs::Error when neither gives a range.
+DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,
+                         const SourceViewOptions& options);
+
+// The epipolar direction, modulo pi, at image point `point_px` of the reference: the direction
+// of the line through `point_px` and the source camera centre projected into the reference.
+double EpipolarDirectionRad(const Reconstruction& model, uint32_t reference_id,
+                            uint32_t source_id, const Eigen::Vector2d& point_px);
+
+// --- The cfg files.
+struct PatchMatchProblem {
+  enum class Kind { kExplicit, kAll, kAuto };
+  std::string reference;
+  Kind kind = Kind::kAuto;
+  std::vector<std::string> sources;  // kExplicit
+  int num_auto = 0;                  // kAuto: N of `__auto__, N`
+  int line_number = 0;               // of the sources line, for messages
+};
+// Throws hairmvs::Error naming `path` and the line for: a reference without a sources line,
+// `__auto__` without exactly one positive N, an empty name, a name that is not an image of
+// `model`, a reference listing itself.
+std::vector<PatchMatchProblem> ReadPatchMatchConfig(const std::string& path,
+                                                    const Reconstruction& model);
+// fusion.cfg: one image name per line; COLMAP does not skip `#` lines there (it aborts), so a
+// `#` line is an error here too.
+std::vector<std::string> ReadFusionConfig(const std::string& path, const Reconstruction& model);
+// Writers (atomic) in the formats above.
+void WritePatchMatchConfig(const std::string& path, const std::vector<PatchMatchProblem>& problems);
+void WriteFusionConfig(const std::string& path, const std::vector<std::string>& image_names);
+
+}  // namespace hairmvs
