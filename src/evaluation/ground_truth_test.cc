@@ -73,9 +73,9 @@ TEST(GroundTruth, StrandDistanceMatchesBruteForce) {
   std::uniform_real_distribution<double> u(-0.03, 0.09);
   std::uniform_real_distribution<double> noise(-1e-3, 1e-3);
   std::vector<Eigen::Vector3d> queries;
-  for (int i = 0; i < 40; ++i) queries.emplace_back(u(rng), u(rng) * 0.5, u(rng) * 0.6);
+  for (int i = 0; i < 20; ++i) queries.emplace_back(u(rng), u(rng) * 0.5, u(rng) * 0.6);
   // Points close to the strands, where the spline-vs-polyline difference matters.
-  for (int i = 0; i < 40; ++i) {
+  for (int i = 0; i < 20; ++i) {
     const Eigen::Vector3f& p = strands.points[i % strands.points.size()];
     queries.push_back(p.cast<double>() + Eigen::Vector3d(noise(rng), noise(rng), noise(rng)));
   }

@@ -1,0 +1,174 @@
+#pragma once
+// Evaluation against the exact ground truth of the synthetic data sets (shared/data/README.md):
+//   - ImportGroundTruth: a dense workspace whose depth and normal maps are the truth (plus
+//     noise if asked), for testing the stages after stereo;
+//   - EvaluateDepthMaps: per-pixel depth errors and completeness on the hair pixels, and the
+//     3D distance of the back-projected depths to the true strands;
+//   - EvaluateMesh: accuracy (mesh to strands) and completeness (visible true hair surface to
+//     mesh), as the DTU benchmark measures them.
+// Distances are reported in millimetres (fields *_mm), inputs are in metres (*_m).
+
+#include <string>
+#include <vector>
+
+namespace hairmvs {
+
+struct ImportGroundTruthOptions {
+  // Standard deviation of the Gaussian noise added to every written depth (0 = exact).
+  double noise_m = 0.0;
+  int seed = 0;
+  // Keep only hair pixels (label 2); otherwise hair and head skin (labels 1, 2).
+  bool hair_only = false;
+  // Median-filter the true depth maps (k x k over the kept pixels, 0 = off) before writing:
+  // the README's "ideal smooth surface" (7).
+  int median_filter_px = 0;
+  // Copy images/ and masks/ instead of symlinking them.
+  bool copy_images = false;
+  // Empty: every image of the workspace.
+  std::vector<std::string> image_names;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("noise_m", &noise_m, "std. dev. of Gaussian noise added to the true depths (m)");
+    v("seed", &seed, "random seed of the noise");
+    v("hair_only", &hair_only, "keep hair pixels only (else hair and head skin)");
+    v("median_filter_px", &median_filter_px,
+      "median-filter the true depths over a k x k window (0 = off; odd)");
+    v("copy_images", &copy_images, "copy images/ and masks/ instead of symlinking");
+    v("image_names", &image_names, "views to write (comma-separated; empty = all)");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct ImportGroundTruthResult {
+  std::string output_path;
+  int num_views = 0;
+  double kept_pixel_fraction = 0;  // of all pixels, over the views
+  std::string Report() const;
+};
+
+// Writes a new workspace `output_path` (never inside the shared data): sparse/ copied from the
+// workspace, images/ and masks/ linked (or copied), stereo/{patch-match,fusion}.cfg copied,
+// stereo/depth_maps/<name>.geometric.bin (true z-depth, SfM pixel convention, 0 outside the
+// kept labels) and stereo/normal_maps/<name>.geometric.bin (camera-frame normals of that
+// depth map). The workspace's cameras must have the ground truth's image size.
+ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
+                                          const std::string& workspace_path,
+                                          const std::string& output_path,
+                                          const ImportGroundTruthOptions& options);
+
+struct DepthEvaluationOptions {
+  std::string depth_type = "geometric";
+  // Empty: every image of the workspace that has a depth map of depth_type.
+  std::vector<std::string> image_names;
+  // Error pictures and the JSON go here; empty = <workspace>/stereo/evaluation.
+  std::string output_path;
+  bool write_error_images = true;
+  // Colour scale of the error pictures: 0 (blue) to this (red), in mm.
+  double error_image_max_mm = 10.0;
+  // 3D accuracy from at most this many randomly chosen pixels per view (0 = all).
+  int max_points_3d_per_view = 0;
+  int seed = 0;
+  // Spline sampling of the true strands (StrandDistance).
+  double strand_spacing_m = 2e-4;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("depth_type", &depth_type, "geometric or photometric");
+    v("image_names", &image_names, "views to evaluate (comma-separated; empty = all)");
+    v("output_path", &output_path, "folder for error pictures and JSON (default W/stereo/evaluation)");
+    v("write_error_images", &write_error_images, "write <name>.error.png per view");
+    v("error_image_max_mm", &error_image_max_mm, "error at the red end of the colour scale (mm)");
+    v("max_points_3d_per_view", &max_points_3d_per_view,
+      "subsample the 3D accuracy to this many pixels per view (0 = all)");
+    v("seed", &seed, "random seed of the subsampling");
+    v("strand_spacing_m", &strand_spacing_m, "spline sampling of the true strands (m)");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct DepthMetrics {
+  std::string name;  // image name, or "overall"
+  long num_hair_pixels = 0;
+  long num_with_depth = 0;       // hair pixels with a depth > 0
+  double completeness = 0;       // num_with_depth / num_hair_pixels
+  // |depth - true depth| on hair pixels with a depth.
+  double mean_abs_error_mm = 0;
+  double median_abs_error_mm = 0;
+  double within_1mm = 0;  // fractions of num_with_depth
+  double within_2mm = 0;
+  double within_5mm = 0;
+  // 3D: back-projected with the workspace's camera, distance to the nearest true strand.
+  long num_points_3d = 0;
+  double accuracy_3d_mean_mm = 0;
+  double accuracy_3d_median_mm = 0;
+  double accuracy_3d_p90_mm = 0;
+};
+
+struct DepthEvaluationResult {
+  std::vector<DepthMetrics> views;
+  DepthMetrics overall;  // pooled over all views' pixels
+  std::string json_path;
+  std::string Table() const;
+};
+
+DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
+                                        const std::string& ground_truth_path,
+                                        const DepthEvaluationOptions& options);
+
+struct MeshEvaluationOptions {
+  // Accuracy also from points sampled on the faces, about this far apart (0 = vertices only).
+  double face_sample_spacing_m = 5e-4;
+  // The mesh surface is sampled this densely for completeness (nearest-sample distance; a
+  // sample spacing s overestimates a distance by at most ~s/2, and less for distances >> s).
+  double surface_sample_spacing_m = 2e-4;
+  // True visible hair surface: hair pixels of every view, at most this many (random).
+  int max_ground_truth_points = 300000;
+  int seed = 0;
+  double strand_spacing_m = 2e-4;
+  // JSON summary; empty = <workspace>/stereo/evaluation/mesh_evaluation.json when a workspace
+  // is given, else <mesh>.evaluation.json.
+  std::string output_json;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("face_sample_spacing_m", &face_sample_spacing_m,
+      "accuracy also from face samples this far apart (0 = vertices only)");
+    v("surface_sample_spacing_m", &surface_sample_spacing_m,
+      "mesh surface sampling for completeness distances (m)");
+    v("max_ground_truth_points", &max_ground_truth_points,
+      "subsample of the visible true hair surface");
+    v("seed", &seed, "random seed of the subsampling");
+    v("strand_spacing_m", &strand_spacing_m, "spline sampling of the true strands (m)");
+    v("output_json", &output_json, "JSON summary path");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct DistanceStats {
+  long count = 0;
+  double mean_mm = 0;
+  double median_mm = 0;
+  double p90_mm = 0;
+};
+
+struct MeshEvaluationResult {
+  long num_vertices = 0;
+  long num_faces = 0;
+  DistanceStats accuracy_vertices;  // mesh vertices to the nearest true strand
+  DistanceStats accuracy_surface;   // vertices and face samples to the nearest true strand
+  DistanceStats completeness_distance;  // true visible hair surface to the mesh
+  double completeness_2mm = 0;  // fraction of the true visible hair surface within 2 mm
+  double completeness_5mm = 0;
+  std::string json_path;
+  std::string Report() const;
+};
+
+// `workspace_path` may be empty; when given, the visible surface uses the views of the
+// workspace only and the JSON goes into its stereo/evaluation folder.
+MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
+                                  const std::string& ground_truth_path,
+                                  const std::string& workspace_path,
+                                  const MeshEvaluationOptions& options);
+
+}  // namespace hairmvs

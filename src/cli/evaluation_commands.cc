@@ -1,0 +1,104 @@
+// hairmvs import_ground_truth / evaluate_depth / evaluate_mesh: the ground truth of the
+// synthetic data sets (shared/data/README.md) as a workspace, and the evaluators.
+
+#include <cstdio>
+#include <string>
+
+#include "hairmvs/evaluation.h"
+#include "src/cli/command_registry.h"
+#include "src/core/logging.h"
+#include "src/core/option_parser.h"
+#include "src/core/timer.h"
+
+namespace hairmvs {
+namespace {
+
+// The options of these commands are plain (--noise_m, --depth_type...), as in the README.
+template <typename OptionsT>
+void AddPlain(OptionParser* parser, OptionsT* options) {
+  options->ForEachField(
+      [parser](const char* field, auto* ptr, const char* help) { parser->Add(field, ptr, help); });
+}
+
+template <typename OptionsT>
+void CheckOrThrow(const OptionsT& options) {
+  std::string error;
+  THROW_IF(!options.Check(&error), "invalid option: " << error);
+}
+
+int RunImportGroundTruth(int argc, char** argv) {
+  std::string ground_truth_path, workspace_path, output_path;
+  ImportGroundTruthOptions options;
+  OptionParser parser(
+      "import_ground_truth",
+      "Writes a new dense workspace whose depth and normal maps are the ground truth (plus "
+      "noise if asked): sparse/ copied, images/ and masks/ linked, stereo/*.cfg copied, "
+      "stereo/depth_maps/<name>.geometric.bin and stereo/normal_maps/<name>.geometric.bin.");
+  parser.Add("ground_truth_path", &ground_truth_path, "the data set's gt/ folder", true);
+  parser.Add("workspace_path", &workspace_path, "the data set's dense workspace", true);
+  parser.Add("output_path", &output_path, "the new workspace (not inside the data set)", true);
+  AddPlain(&parser, &options);
+  if (!parser.Parse(argc, argv)) return 0;
+  CheckOrThrow(options);
+  const ImportGroundTruthResult result =
+      ImportGroundTruth(ground_truth_path, workspace_path, output_path, options);
+  std::printf("%s\n", result.Report().c_str());
+  return 0;
+}
+
+int RunEvaluateDepth(int argc, char** argv) {
+  std::string ground_truth_path, workspace_path;
+  DepthEvaluationOptions options;
+  OptionParser parser(
+      "evaluate_depth",
+      "Compares a workspace's depth maps with the true ones on the hair pixels (label 2): "
+      "absolute error (mean, median, fraction within 1/2/5 mm), completeness, and 3D accuracy "
+      "(pixels back-projected with the workspace's cameras, distance to the nearest true "
+      "strand). Writes <output>/<name>.error.png and <output>/depth_evaluation.json.");
+  parser.Add("workspace_path", &workspace_path, "dense workspace with depth maps", true);
+  parser.Add("ground_truth_path", &ground_truth_path, "the data set's gt/ folder", true);
+  AddPlain(&parser, &options);
+  if (!parser.Parse(argc, argv)) return 0;
+  CheckOrThrow(options);
+  Timer timer;
+  const DepthEvaluationResult result =
+      EvaluateDepthMaps(workspace_path, ground_truth_path, options);
+  std::printf("%s", result.Table().c_str());
+  std::printf("Evaluated %zu views in %.1f s\n", result.views.size(), timer.ElapsedSeconds());
+  return 0;
+}
+
+int RunEvaluateMesh(int argc, char** argv) {
+  std::string mesh_path, ground_truth_path, workspace_path;
+  MeshEvaluationOptions options;
+  OptionParser parser(
+      "evaluate_mesh",
+      "Accuracy (mesh vertices and surface samples to the nearest true strand) and "
+      "completeness (the visible true hair surface, i.e. hair pixels of the true depth maps "
+      "back-projected with the true cameras, to the mesh surface: fraction within 2 and 5 mm), "
+      "as the DTU benchmark measures them.");
+  parser.Add("mesh", &mesh_path, "triangle mesh (PLY)", true);
+  parser.Add("ground_truth_path", &ground_truth_path, "the data set's gt/ folder", true);
+  parser.Add("workspace_path", &workspace_path,
+             "optional: use its views for the visible surface and write the JSON into its "
+             "stereo/evaluation/");
+  AddPlain(&parser, &options);
+  if (!parser.Parse(argc, argv)) return 0;
+  CheckOrThrow(options);
+  Timer timer;
+  const MeshEvaluationResult result =
+      EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options);
+  std::printf("%sEvaluated in %.1f s\n", result.Report().c_str(), timer.ElapsedSeconds());
+  return 0;
+}
+
+}  // namespace
+
+HAIRMVS_REGISTER_COMMAND("import_ground_truth", RunImportGroundTruth,
+                         "a workspace with the true depth/normal maps of a synthetic set");
+HAIRMVS_REGISTER_COMMAND("evaluate_depth", RunEvaluateDepth,
+                         "depth maps vs. the ground truth (per-pixel, completeness, 3D)");
+HAIRMVS_REGISTER_COMMAND("evaluate_mesh", RunEvaluateMesh,
+                         "mesh accuracy and completeness vs. the true strands (DTU-style)");
+
+}  // namespace hairmvs

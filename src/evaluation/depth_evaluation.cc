@@ -1,0 +1,245 @@
+// hairmvs evaluate_depth: depth maps of a workspace against the true depth and strands.
+
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/workspace.h"
+#include "hairmvs/evaluation.h"
+#include "src/core/depth_geometry.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/evaluation/evaluation_util.h"
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace {
+
+// The per-pixel samples of one view (or of all views pooled).
+struct DepthSamples {
+  long num_hair_pixels = 0;
+  std::vector<double> abs_errors_m;   // hair pixels with a depth
+  std::vector<double> distances_3d_m;  // a subset of them, back-projected
+};
+
+DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
+  DepthMetrics m;
+  m.name = name;
+  m.num_hair_pixels = samples.num_hair_pixels;
+  m.num_with_depth = static_cast<long>(samples.abs_errors_m.size());
+  m.completeness = m.num_hair_pixels > 0 ? static_cast<double>(m.num_with_depth) / m.num_hair_pixels
+                                         : 0.0;
+  const DistanceStats errors = SummarizeDistances(samples.abs_errors_m);
+  m.mean_abs_error_mm = errors.mean_mm;
+  m.median_abs_error_mm = errors.median_mm;
+  long n1 = 0, n2 = 0, n5 = 0;
+  for (double e : samples.abs_errors_m) {
+    n1 += e <= 1e-3;
+    n2 += e <= 2e-3;
+    n5 += e <= 5e-3;
+  }
+  const double n = std::max<long>(1, m.num_with_depth);
+  m.within_1mm = n1 / n;
+  m.within_2mm = n2 / n;
+  m.within_5mm = n5 / n;
+  const DistanceStats accuracy = SummarizeDistances(samples.distances_3d_m);
+  m.num_points_3d = accuracy.count;
+  m.accuracy_3d_mean_mm = accuracy.mean_mm;
+  m.accuracy_3d_median_mm = accuracy.median_mm;
+  m.accuracy_3d_p90_mm = accuracy.p90_mm;
+  return m;
+}
+
+nlohmann::json ToJson(const DepthMetrics& m) {
+  return {{"name", m.name},
+          {"num_hair_pixels", m.num_hair_pixels},
+          {"num_with_depth", m.num_with_depth},
+          {"completeness", m.completeness},
+          {"mean_abs_error_mm", m.mean_abs_error_mm},
+          {"median_abs_error_mm", m.median_abs_error_mm},
+          {"within_1mm", m.within_1mm},
+          {"within_2mm", m.within_2mm},
+          {"within_5mm", m.within_5mm},
+          {"num_points_3d", m.num_points_3d},
+          {"accuracy_3d_mean_mm", m.accuracy_3d_mean_mm},
+          {"accuracy_3d_median_mm", m.accuracy_3d_median_mm},
+          {"accuracy_3d_p90_mm", m.accuracy_3d_p90_mm}};
+}
+
+std::string TableRow(const DepthMetrics& m) {
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "%-14s %9ld %7.1f%% %8.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %8.3f %8.3f\n",
+                m.name.c_str(), m.num_hair_pixels, 100 * m.completeness, m.mean_abs_error_mm,
+                m.median_abs_error_mm, 100 * m.within_1mm, 100 * m.within_2mm,
+                100 * m.within_5mm, m.accuracy_3d_mean_mm, m.accuracy_3d_median_mm);
+  return line;
+}
+
+}  // namespace
+
+bool DepthEvaluationOptions::Check(std::string* error) const {
+  if (depth_type != "geometric" && depth_type != "photometric") {
+    *error = "EvaluateDepth.depth_type must be geometric or photometric";
+    return false;
+  }
+  if (!(error_image_max_mm > 0)) {
+    *error = "EvaluateDepth.error_image_max_mm must be > 0";
+    return false;
+  }
+  if (max_points_3d_per_view < 0) {
+    *error = "EvaluateDepth.max_points_3d_per_view must be >= 0";
+    return false;
+  }
+  if (!(strand_spacing_m > 0)) {
+    *error = "EvaluateDepth.strand_spacing_m must be > 0";
+    return false;
+  }
+  return CheckImageNames(image_names, error);
+}
+
+std::string DepthEvaluationResult::Table() const {
+  std::ostringstream out;
+  out << "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
+         "3d_med\n";
+  for (const DepthMetrics& m : views) out << TableRow(m);
+  out << TableRow(overall);
+  if (!json_path.empty()) out << "Summary: " << json_path << "\n";
+  return out.str();
+}
+
+DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
+                                        const std::string& ground_truth_path,
+                                        const DepthEvaluationOptions& options) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  const Workspace ws = Workspace::Read(workspace_path);
+  std::vector<std::string> names = options.image_names;
+  if (names.empty()) {
+    for (const std::string& name : ws.ImageNames()) {
+      if (ExistsFile(ws.DepthMapPath(name, options.depth_type))) names.push_back(name);
+    }
+    THROW_IF(names.empty(), "No " << options.depth_type << " depth maps in "
+                                  << JoinPaths(ws.StereoPath(), "depth_maps"));
+  }
+  const std::string output_path = options.output_path.empty()
+                                      ? JoinPaths(ws.StereoPath(), "evaluation")
+                                      : options.output_path;
+  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
+  Timer timer;
+  const StrandDistance strand_distance(strands, options.strand_spacing_m);
+  LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
+            << strand_distance.NumSamples() << " centreline samples (" << std::fixed
+            << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
+
+  DepthEvaluationResult result;
+  DepthSamples pooled;
+  std::mt19937 rng(options.seed);
+  Progress progress("evaluate_depth", static_cast<int>(names.size()));
+  for (size_t v = 0; v < names.size(); ++v) {
+    const std::string& name = names[v];
+    progress.Start(static_cast<int>(v), name);
+    const FloatMap depth = ReadMat(ws.DepthMapPath(name, options.depth_type));
+    THROW_IF(depth.Channels() != 1,
+             ws.DepthMapPath(name, options.depth_type) << ": a depth map has 1 channel");
+    const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
+    const int width = depth.Width(), height = depth.Height();
+    const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
+    // The workspace camera, scaled to the depth map (SfM convention: the image edges map to
+    // the image edges, so pixel-centre coordinates scale by the size ratio).
+    const Camera& camera = ws.CameraOf(name);
+    Eigen::Matrix3d K = camera.CalibrationMatrix();
+    K.row(0) *= static_cast<double>(width) / camera.width;
+    K.row(1) *= static_cast<double>(height) / camera.height;
+    const Image& image = ws.ImageByName(name);
+    const Eigen::Matrix3d R = image.R();
+    const Eigen::Vector3d t = image.t();
+
+    DepthSamples samples;
+    std::vector<Eigen::Vector3d> points;
+    // Error picture: black background, dark grey skin, grey = hair pixel without a depth,
+    // colour = error level of a hair pixel with a depth (blue 0 mm .. red error_image_max_mm).
+    cv::Mat error_image(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
+    cv::Mat levels(height, width, CV_8UC1, cv::Scalar(0));
+    cv::Mat has_depth(height, width, CV_8UC1, cv::Scalar(0));
+    for (int r = 0; r < height; ++r) {
+      const int gr = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
+      for (int c = 0; c < width; ++c) {
+        const int gc = std::min(gt_width - 1, (2 * c + 1) * gt_width / (2 * width));
+        const uint8_t label = gt.label[static_cast<size_t>(gr) * gt_width + gc];
+        const float d = depth.At(r, c);
+        cv::Vec3b& pixel = error_image.at<cv::Vec3b>(r, c);
+        if (label != kLabelHair) {
+          if (label == kLabelSkin) pixel = cv::Vec3b(40, 40, 40);
+          if (d > 0) pixel = cv::Vec3b(90, 60, 60);  // a depth outside the hair: blue-grey
+          continue;
+        }
+        ++samples.num_hair_pixels;
+        if (!(d > 0)) {
+          pixel = cv::Vec3b(160, 160, 160);  // missing: grey
+          continue;
+        }
+        const double abs_error = std::abs(static_cast<double>(d) - gt.depth.At(gr, gc));
+        samples.abs_errors_m.push_back(abs_error);
+        const double level = std::min(1.0, 1e3 * abs_error / options.error_image_max_mm);
+        levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * level));
+        has_depth.at<uint8_t>(r, c) = 255;
+        points.push_back(R.transpose() * (BackProjectPixel(K, c, r, d) - t));
+      }
+    }
+    if (options.max_points_3d_per_view > 0 &&
+        points.size() > static_cast<size_t>(options.max_points_3d_per_view)) {
+      std::shuffle(points.begin(), points.end(), rng);
+      points.resize(options.max_points_3d_per_view);
+    }
+    progress.Stage("3D distances");
+    samples.distances_3d_m = strand_distance.Distances(points);
+    result.views.push_back(Summarize(name, samples));
+
+    if (options.write_error_images) {
+      cv::Mat colours;
+      cv::applyColorMap(levels, colours, cv::COLORMAP_JET);
+      colours.copyTo(error_image, has_depth);
+      const std::string png = JoinPaths(output_path, name + ".error.png");
+      WritePathAtomically(png, [&](const std::string& tmp) {
+        THROW_IF(!cv::imwrite(tmp, error_image), "Cannot write " << png);
+      });
+    }
+    pooled.num_hair_pixels += samples.num_hair_pixels;
+    pooled.abs_errors_m.insert(pooled.abs_errors_m.end(), samples.abs_errors_m.begin(),
+                               samples.abs_errors_m.end());
+    pooled.distances_3d_m.insert(pooled.distances_3d_m.end(), samples.distances_3d_m.begin(),
+                                 samples.distances_3d_m.end());
+  }
+  progress.Finish();
+  result.overall = Summarize("overall", pooled);
+
+  nlohmann::json json;
+  json["workspace_path"] = workspace_path;
+  json["ground_truth_path"] = ground_truth_path;
+  json["depth_type"] = options.depth_type;
+  json["pixel_convention"] = "SfM: pixel (col, row) centred at (col + 0.5, row + 0.5)";
+  json["max_points_3d_per_view"] = options.max_points_3d_per_view;
+  json["strand_spacing_m"] = options.strand_spacing_m;
+  json["overall"] = ToJson(result.overall);
+  json["views"] = nlohmann::json::array();
+  for (const DepthMetrics& m : result.views) json["views"].push_back(ToJson(m));
+  result.json_path = JoinPaths(output_path, "depth_evaluation.json");
+  const std::string text = json.dump(1);
+  WriteFileAtomically(result.json_path, [&text](std::ostream& out) { out << text << "\n"; },
+                      false);
+  return result;
+}
+
+}  // namespace hairmvs

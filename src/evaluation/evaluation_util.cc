@@ -1,0 +1,80 @@
+#include "src/evaluation/evaluation_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "src/core/logging.h"
+
+namespace hairmvs {
+
+double Mean(const std::vector<double>& values) {
+  if (values.empty()) return 0.0;
+  return std::accumulate(values.begin(), values.end(), 0.0) / values.size();
+}
+
+double Percentile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  const size_t k = std::min(values.size() - 1,
+                            static_cast<size_t>(std::floor(q * (values.size() - 1) + 0.5)));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+DistanceStats SummarizeDistances(std::vector<double> distances_m) {
+  DistanceStats stats;
+  stats.count = static_cast<long>(distances_m.size());
+  if (distances_m.empty()) return stats;
+  stats.mean_mm = 1e3 * Mean(distances_m);
+  std::sort(distances_m.begin(), distances_m.end());
+  const size_t n = distances_m.size();
+  stats.median_mm = 1e3 * (n % 2 ? distances_m[n / 2]
+                                 : 0.5 * (distances_m[n / 2 - 1] + distances_m[n / 2]));
+  stats.p90_mm = 1e3 * distances_m[std::min(n - 1, static_cast<size_t>(0.9 * (n - 1) + 0.5))];
+  return stats;
+}
+
+FloatMap MedianFilterValidDepths(const FloatMap& depth, int k) {
+  CHECK_EQ(depth.Channels(), 1);
+  CHECK(k >= 1 && k % 2 == 1) << "median filter size must be odd";
+  const int radius = k / 2;
+  const int width = depth.Width();
+  const int height = depth.Height();
+  FloatMap out(width, height, 1, 0.0f);
+#pragma omp parallel for schedule(dynamic, 8)
+  for (int r = 0; r < height; ++r) {
+    std::vector<float> window;
+    window.reserve(k * k);
+    for (int c = 0; c < width; ++c) {
+      if (!(depth.At(r, c) > 0)) continue;
+      window.clear();
+      for (int rr = std::max(0, r - radius); rr <= std::min(height - 1, r + radius); ++rr) {
+        for (int cc = std::max(0, c - radius); cc <= std::min(width - 1, c + radius); ++cc) {
+          const float d = depth.At(rr, cc);
+          if (d > 0) window.push_back(d);
+        }
+      }
+      const size_t n = window.size();
+      std::nth_element(window.begin(), window.begin() + n / 2, window.end());
+      float median = window[n / 2];
+      if (n % 2 == 0) {
+        const float lower = *std::max_element(window.begin(), window.begin() + n / 2);
+        median = 0.5f * (median + lower);
+      }
+      out.At(r, c) = median;
+    }
+  }
+  return out;
+}
+
+bool CheckImageNames(const std::vector<std::string>& names, std::string* error) {
+  for (const std::string& name : names) {
+    if (name.empty()) {
+      *error = "image_names: empty name";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace hairmvs

@@ -1,0 +1,160 @@
+// hairmvs import_ground_truth: a dense workspace whose depth and normal maps are the truth.
+
+#include <Eigen/Core>
+#include <filesystem>
+#include <iomanip>
+#include <random>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/workspace.h"
+#include "hairmvs/evaluation.h"
+#include "src/core/depth_geometry.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/evaluation/evaluation_util.h"
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace fs = std::filesystem;
+
+namespace {
+
+bool IsSameOrInside(const fs::path& inner, const fs::path& outer) {
+  const fs::path a = fs::weakly_canonical(inner);
+  const fs::path b = fs::weakly_canonical(outer);
+  auto ia = a.begin();
+  for (auto ib = b.begin(); ib != b.end(); ++ib, ++ia) {
+    if (ia == a.end() || *ia != *ib) return false;
+  }
+  return true;
+}
+
+void CopyFileAtomically(const std::string& from, const std::string& to) {
+  const std::string bytes = ReadTextFile(from);
+  WriteFileAtomically(to, [&bytes](std::ostream& out) { out.write(bytes.data(), bytes.size()); });
+}
+
+// images/ or masks/ of the output: a symlink to the workspace's folder, or a copy.
+void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy) {
+  if (!ExistsDir(from)) return;
+  std::error_code ec;
+  if (fs::is_symlink(to, ec)) fs::remove(to, ec);
+  if (!copy) {
+    THROW_IF(fs::exists(to), "Cannot link " << to << " to " << from
+                                            << ": a folder of that name exists (use "
+                                               "--ImportGroundTruth.copy_images 1 or remove it)");
+    fs::create_directory_symlink(fs::absolute(from), to, ec);
+    THROW_IF(ec, "Cannot create the symlink " << to << " -> " << from << ": " << ec.message());
+    return;
+  }
+  for (const auto& entry : fs::recursive_directory_iterator(from)) {
+    if (!entry.is_regular_file()) continue;
+    const std::string relative = fs::relative(entry.path(), from).string();
+    CopyFileAtomically(entry.path().string(), JoinPaths(to, relative));
+  }
+}
+
+}  // namespace
+
+bool ImportGroundTruthOptions::Check(std::string* error) const {
+  if (!(noise_m >= 0)) {
+    *error = "ImportGroundTruth.noise_m must be >= 0";
+    return false;
+  }
+  if (median_filter_px < 0 || (median_filter_px > 0 && median_filter_px % 2 == 0)) {
+    *error = "ImportGroundTruth.median_filter_px must be 0 or odd";
+    return false;
+  }
+  return CheckImageNames(image_names, error);
+}
+
+std::string ImportGroundTruthResult::Report() const {
+  std::ostringstream out;
+  out << "Wrote " << num_views << " true depth and normal maps into " << output_path
+      << " (kept " << std::fixed << std::setprecision(1) << 100.0 * kept_pixel_fraction
+      << "% of the pixels)";
+  return out.str();
+}
+
+ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
+                                          const std::string& workspace_path,
+                                          const std::string& output_path,
+                                          const ImportGroundTruthOptions& options) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  THROW_IF(output_path.empty(), "Empty --output_path");
+  RequireDir(ground_truth_path, "ground truth folder (--ground_truth_path)");
+  THROW_IF(IsSameOrInside(output_path, workspace_path),
+           "--output_path " << output_path << " is inside the workspace " << workspace_path
+                            << ": import_ground_truth writes a new workspace");
+  THROW_IF(IsSameOrInside(output_path, ground_truth_path) ||
+               IsSameOrInside(output_path, ParentPath(fs::weakly_canonical(ground_truth_path))),
+           "--output_path " << output_path << " is inside the data set of "
+                            << ground_truth_path << ", which is read-only");
+  const Workspace ws = Workspace::Read(workspace_path);
+  std::vector<std::string> names = options.image_names;
+  if (names.empty()) names = ws.ImageNames();
+  for (const std::string& name : names) ws.ImageIdx(name);  // throws for an unknown name
+
+  // The frame of the new workspace: model, images, masks, configuration.
+  CreateDirs(output_path);
+  const std::string sparse_in = JoinPaths(workspace_path, "sparse");
+  for (const auto& entry : fs::directory_iterator(sparse_in)) {
+    if (entry.is_regular_file()) {
+      CopyFileAtomically(entry.path().string(),
+                         JoinPaths(output_path, "sparse", entry.path().filename().string()));
+    }
+  }
+  LinkOrCopyFolder(JoinPaths(workspace_path, "images"), JoinPaths(output_path, "images"),
+                   options.copy_images);
+  LinkOrCopyFolder(JoinPaths(workspace_path, "masks"), JoinPaths(output_path, "masks"),
+                   options.copy_images);
+  for (const char* cfg : {"patch-match.cfg", "fusion.cfg"}) {
+    const std::string from = JoinPaths(workspace_path, "stereo", cfg);
+    if (ExistsFile(from)) CopyFileAtomically(from, JoinPaths(output_path, "stereo", cfg));
+  }
+  const Workspace out_ws = Workspace::Read(output_path);
+
+  ImportGroundTruthResult result;
+  result.output_path = output_path;
+  std::mt19937 rng(options.seed);
+  std::normal_distribution<double> noise(0.0, options.noise_m);
+  size_t kept = 0, total = 0;
+  Progress progress("import_ground_truth", static_cast<int>(names.size()));
+  for (const std::string& name : names) {
+    progress.Start(result.num_views, name);
+    const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
+    const Camera& camera = ws.CameraOf(name);
+    THROW_IF(static_cast<int>(camera.width) != view.depth.Width() ||
+                 static_cast<int>(camera.height) != view.depth.Height(),
+             "Image " << name << ": the workspace camera is " << camera.width << " x "
+                      << camera.height << " but the ground truth "
+                      << GroundTruthViewPath(ground_truth_path, name) << " is "
+                      << view.depth.Width() << " x " << view.depth.Height());
+    FloatMap depth = view.depth;
+    for (size_t p = 0; p < depth.NumPixels(); ++p) {
+      const uint8_t label = view.label[p];
+      const bool keep = label == kLabelHair || (!options.hair_only && label == kLabelSkin);
+      if (!keep) depth.Data()[p] = 0.0f;
+    }
+    if (options.median_filter_px > 1) depth = MedianFilterValidDepths(depth, options.median_filter_px);
+    for (float& d : depth.Data()) {
+      if (d > 0) {
+        ++kept;
+        if (options.noise_m > 0) d = static_cast<float>(std::max(1e-6, d + noise(rng)));
+      }
+    }
+    total += depth.NumPixels();
+    const Eigen::Matrix3d K = camera.CalibrationMatrix();
+    WriteMat(out_ws.DepthMapPath(name, "geometric"), depth);
+    WriteMat(out_ws.NormalMapPath(name, "geometric"), NormalMapFromDepthMap(depth, K));
+    ++result.num_views;
+  }
+  progress.Finish();
+  result.kept_pixel_fraction = total > 0 ? static_cast<double>(kept) / total : 0.0;
+  return result;
+}
+
+}  // namespace hairmvs
