@@ -1,0 +1,243 @@
+#include "colmap_ext/source_views.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "colmap_ext/test_util.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::MakeTestDir;
+using testing_util::WriteTestWorkspace;
+
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+// Views with identity rotation at `centres` (camera y points down, so +y is "below"), named
+// by `names`; points on the plane z = 2; point k is seen by the views whose bit is set in
+// `visibility[k]`.
+Reconstruction MakeRig(const std::vector<Eigen::Vector3d>& centres,
+                       const std::vector<std::string>& names,
+                       const std::vector<unsigned>& visibility) {
+  testing_util::PlaneModelOptions options;
+  options.centres = centres;
+  options.plane_z_m = 2.0;
+  options.num_points = static_cast<int>(visibility.size());
+  Reconstruction r = testing_util::MakePlaneModel(options);
+  for (auto& [id, image] : r.images) image.name = names[id - 1];
+  for (auto& [pid, point] : r.points3D) {
+    std::vector<TrackElement> track;
+    for (const TrackElement& el : point.track) {
+      if (visibility[pid - 1] & (1u << (el.image_id - 1))) track.push_back(el);
+    }
+    point.track = track;
+  }
+  return r;
+}
+
+Workspace WriteAndRead(const std::string& name, const Reconstruction& model) {
+  const std::string dir = MakeTestDir(name);
+  WriteTestWorkspace(dir, model);
+  return Workspace::Read(dir);
+}
+
+TEST(SourceViews, EpipolarSpreadPrefersADifferentDirection) {
+  // ref, three horizontal neighbours sharing 40 points, one vertical sharing 20.
+  std::vector<unsigned> visibility(40, 0b01111u);
+  for (int k = 0; k < 20; ++k) visibility[k] |= 0b10000u;
+  const Reconstruction model =
+      MakeRig({{0, 0, 0}, {0.1, 0, 0}, {0.2, 0, 0}, {-0.1, 0, 0}, {0, 0.2, 0}},
+              {"ref.png", "h1.png", "h2.png", "h3.png", "v1.png"}, visibility);
+  const Workspace ws = WriteAndRead("spread", model);
+  SourceViewOptions options;
+  options.max_num_source_views = 2;
+  options.epipolar_spread_weight = 0;  // COLMAP's ranking: shared points only
+  std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 5u);
+  EXPECT_EQ(s[0].reference, "ref.png");
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"h1.png", "h2.png"}));
+  EXPECT_FALSE(s[0].gantry_t_group);
+  options.epipolar_spread_weight = 2;
+  s = SelectSourceViews(ws, options);
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"h1.png", "v1.png"}));
+  ASSERT_EQ(s[0].epipolar_direction_deg.size(), 2u);
+  EXPECT_NEAR(s[0].epipolar_direction_deg[0], 0.0, 1e-6);
+  EXPECT_NEAR(s[0].epipolar_direction_deg[1], 90.0, 1e-6);
+  EXPECT_EQ(s[0].shared_points, (std::vector<int>{40, 20}));
+  EXPECT_NE(s[0].reason.find("epipolar"), std::string::npos) << s[0].reason;
+}
+
+TEST(SourceViews, GantryTGroupIsRecognisedAndChosenFirst) {
+  // Centre, left, right, bottom (the paper's rig) and a far view sharing more points.
+  std::vector<unsigned> visibility(40, 0b11111u);
+  const Reconstruction model =
+      MakeRig({{0, 0, 0}, {-0.1, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, {0.4, 0.3, 0}},
+              {"c.png", "l.png", "r.png", "b.png", "far.png"}, visibility);
+  const Workspace ws = WriteAndRead("tgroup", model);
+  SourceViewOptions options;
+  options.max_num_source_views = 4;
+  const std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 5u);
+  EXPECT_TRUE(s[0].gantry_t_group) << s[0].reason;
+  ASSERT_GE(s[0].sources.size(), 3u);
+  EXPECT_EQ(std::vector<std::string>(s[0].sources.begin(), s[0].sources.begin() + 3),
+            (std::vector<std::string>{"l.png", "r.png", "b.png"}));
+  EXPECT_NE(s[0].reason.find("gantry T group"), std::string::npos);
+  // From the left view, the others are all to the right or diagonal: no T group.
+  EXPECT_FALSE(s[1].gantry_t_group) << s[1].reason;
+  // Only 2 sources wanted: a T group cannot be used whole.
+  options.max_num_source_views = 2;
+  EXPECT_FALSE(SelectSourceViews(ws, options)[0].gantry_t_group);
+}
+
+TEST(SourceViews, TriangulationAngleTestsAndConfig) {
+  std::vector<unsigned> visibility(30, 0b111u);
+  // near.png is 1 mm away: about 0.03 degrees, below the 1 degree test.
+  const Reconstruction model = MakeRig({{0, 0, 0}, {0.001, 0, 0}, {0.1, 0, 0}},
+                                       {"a.png", "near.png", "far.png"}, visibility);
+  const std::string dir = MakeTestDir("config");
+  WriteTestWorkspace(dir, model);
+  const Workspace ws = Workspace::Read(dir);
+  SourceViewOptions options;
+  std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"far.png"}));
+  EXPECT_NEAR(s[0].triangulation_angle_deg[0], 2.86, 0.05);
+
+  // The cfg is honoured: explicit list (separators , and ;), __all__, __auto__ with comments.
+  WriteFileAtomically(JoinPaths(dir, "stereo", "patch-match.cfg"), [](std::ostream& out) {
+    out << "# a comment\n a.png \nnear.png; far.png\n\nfar.png\n__all__\n"
+           "near.png\n# between\n__auto__, 7\n";
+  });
+  s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"near.png", "far.png"}));
+  EXPECT_EQ(s[1].reference, "far.png");
+  EXPECT_EQ(s[1].sources, (std::vector<std::string>{"a.png", "near.png"}));
+  EXPECT_EQ(s[2].reference, "near.png");
+  EXPECT_EQ(s[2].sources, (std::vector<std::string>{"far.png"}));  // a.png fails the angle test
+  options.use_config = false;
+  EXPECT_EQ(SelectSourceViews(ws, options).size(), 3u);
+  options.use_config = true;
+  options.config_path = JoinPaths(dir, "missing.cfg");
+  EXPECT_NE(ErrorOf([&] { SelectSourceViews(ws, options); }).find("missing.cfg"),
+            std::string::npos);
+}
+
+TEST(SourceViews, MalformedConfigLinesNameFileAndLine) {
+  const Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}}, {"a.png", "b.png"}, {3, 3});
+  const std::string dir = MakeTestDir("bad_cfg");
+  const std::string path = JoinPaths(dir, "patch-match.cfg");
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"a.png\n__auto__\n", ":2: expected `__auto__, N`"},
+      {"a.png\n__auto__, x\n", ":2: `__auto__, N` needs a positive integer"},
+      {"a.png\n__auto__, 3, 4\n", ":2: expected `__auto__, N`"},
+      {"a.png\n__auto__, 0\n", ":2: `__auto__, N` needs a positive integer"},
+      {"a.png\nb.png, c.png\n", ":2: Image with name `c.png` does not exist"},
+      {"a.png\nb.png,,\n", ":2: empty image name"},
+      {"z.png\nb.png\n", ":1: Image with name `z.png`"},
+      {"a.png\nb.png\nb.png\n", "reference b.png has no sources line"},
+      {"a.png\na.png\n", ":2: reference a.png lists itself"},
+      {"a.png\n__all__, 2\n", ":2: `__all__` takes no arguments"},
+  };
+  for (const auto& [text, expected] : cases) {
+    WriteFileAtomically(path, [&](std::ostream& out) { out << text; });
+    const std::string error = ErrorOf([&] { ReadPatchMatchConfig(path, model); });
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
+  const std::string fusion = JoinPaths(dir, "fusion.cfg");
+  WriteFileAtomically(fusion, [](std::ostream& out) { out << "a.png\n# no\n"; });
+  EXPECT_NE(ErrorOf([&] { ReadFusionConfig(fusion, model); }).find(fusion + ":2: comment"),
+            std::string::npos);
+  WriteFileAtomically(fusion, [](std::ostream& out) { out << "a.png\nq.png\n"; });
+  EXPECT_NE(ErrorOf([&] { ReadFusionConfig(fusion, model); }).find("`q.png`"),
+            std::string::npos);
+}
+
+TEST(SourceViews, ConfigWritersRoundTrip) {
+  const Reconstruction model =
+      MakeRig({{0, 0, 0}, {0.1, 0, 0}, {0.2, 0, 0}}, {"a.png", "b.png", "c.png"}, {7, 7});
+  const std::string dir = MakeTestDir("cfg_io");
+  std::vector<PatchMatchProblem> problems(3);
+  problems[0].reference = "a.png";
+  problems[0].kind = PatchMatchProblem::Kind::kExplicit;
+  problems[0].sources = {"b.png", "c.png"};
+  problems[1].reference = "b.png";
+  problems[1].kind = PatchMatchProblem::Kind::kAll;
+  problems[2].reference = "c.png";
+  problems[2].kind = PatchMatchProblem::Kind::kAuto;
+  problems[2].num_auto = 20;
+  WritePatchMatchConfig(JoinPaths(dir, "pm.cfg"), problems);
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "pm.cfg")),
+            "a.png\nb.png, c.png\nb.png\n__all__\nc.png\n__auto__, 20\n");
+  const std::vector<PatchMatchProblem> read = ReadPatchMatchConfig(JoinPaths(dir, "pm.cfg"), model);
+  ASSERT_EQ(read.size(), 3u);
+  EXPECT_EQ(read[0].sources, problems[0].sources);
+  EXPECT_EQ(read[1].kind, PatchMatchProblem::Kind::kAll);
+  EXPECT_EQ(read[2].num_auto, 20);
+  WriteFusionConfig(JoinPaths(dir, "fusion.cfg"), {"c.png", "a.png"});
+  EXPECT_EQ(ReadFusionConfig(JoinPaths(dir, "fusion.cfg"), model),
+            (std::vector<std::string>{"c.png", "a.png"}));
+}
+
+TEST(SourceViews, EpipolarDirection) {
+  const Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, {0, 0, 0.1}},
+                                       {"a.png", "x.png", "y.png", "z.png"}, {15});
+  const Eigen::Vector2d centre(32, 24);
+  EXPECT_NEAR(EpipolarDirectionRad(model, 1, 2, centre), 0.0, 1e-9);
+  EXPECT_NEAR(EpipolarDirectionRad(model, 1, 3, centre), M_PI / 2, 1e-9);
+  // A forward baseline: epipole at the image centre, lines radiate from it; at (42, 34) the
+  // line points along the diagonal.
+  EXPECT_NEAR(EpipolarDirectionRad(model, 1, 4, Eigen::Vector2d(42, 34)), M_PI / 4, 1e-9);
+}
+
+TEST(DepthRange, ColmapRuleAndOverrides) {
+  Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}}, {"a.png", "b.png"}, {});
+  for (int k = 1; k <= 100; ++k) {
+    Point3D p;
+    p.point3D_id = k;
+    p.xyz = Eigen::Vector3d(0.01 * k, 0, k);  // depth k in view a
+    p.track = {{1, 0}};
+    model.points3D[k] = p;
+  }
+  Point3D behind;
+  behind.point3D_id = 1000;
+  behind.xyz = Eigen::Vector3d(0, 0, -3);
+  behind.track = {{1, 0}};
+  model.points3D[1000] = behind;
+  const DepthRange range = ComputeDepthRange(model, 1);
+  EXPECT_EQ(range.num_points, 100);
+  EXPECT_DOUBLE_EQ(range.min_m, 0.75 * 2);   // d[floor(0.01 * 100)] = d[1] = 2
+  EXPECT_DOUBLE_EQ(range.max_m, 1.25 * 100);  // d[floor(0.99 * 100)] = d[99] = 100
+  const DepthRange none = ComputeDepthRange(model, 2);
+  EXPECT_EQ(none.num_points, 0);
+  EXPECT_EQ(none.min_m, -1);
+
+  const Workspace ws = WriteAndRead("depth", model);
+  SourceViewOptions options;
+  EXPECT_DOUBLE_EQ(DepthRangeFor(ws, "a.png", options).max_m, 125);
+  EXPECT_NE(ErrorOf([&] { DepthRangeFor(ws, "b.png", options); }).find("depth_min"),
+            std::string::npos);
+  options.depth_min = 0.3;
+  options.depth_max = 0.9;
+  EXPECT_DOUBLE_EQ(DepthRangeFor(ws, "b.png", options).min_m, 0.3);
+  options.depth_max = -1;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("depth_min"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace hairmvs
