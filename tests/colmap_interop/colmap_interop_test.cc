@@ -1,0 +1,247 @@
+// Round trips through the real `colmap` binary: what COLMAP writes we read, what we write
+// COLMAP reads (colmap-formats.md sections 4, 5 and 9).
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/ply.h"
+#include "colmap_ext/reconstruction.h"
+#include "colmap_ext/source_views.h"
+#include "colmap_ext/test_util.h"
+#include "colmap_ext/workspace.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::ExpectModelsEqual;
+using testing_util::MakePlaneModel;
+using testing_util::MakeTestDir;
+
+std::string Format(double value) {
+  std::ostringstream ss;
+  ss << std::setprecision(3) << value;
+  return ss.str();
+}
+
+std::string ColmapExecutable() {
+  const char* env = std::getenv("HAIRMVS_COLMAP_EXECUTABLE");
+  return env != nullptr && *env ? env : HAIRMVS_COLMAP_EXECUTABLE;
+}
+
+// Runs `colmap <args>` offscreen; returns the exit code; the output goes to `log_path`.
+int RunColmap(const std::string& args, const std::string& log_path) {
+  const std::string command = "QT_QPA_PLATFORM=offscreen '" + ColmapExecutable() + "' " + args +
+                              " > '" + log_path + "' 2>&1";
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+#define REQUIRE_COLMAP()                                                        \
+  do {                                                                          \
+    if (!ExistsFile(ColmapExecutable())) {                                      \
+      GTEST_SKIP() << "colmap executable not found: " << ColmapExecutable();    \
+    }                                                                           \
+  } while (0)
+
+#define EXPECT_COLMAP_OK(args, dir)                                            \
+  do {                                                                         \
+    const std::string log_ = JoinPaths(dir, "colmap.log");                     \
+    const int rc_ = RunColmap(args, log_);                                     \
+    ASSERT_EQ(rc_, 0) << "colmap " << args << "\n" << ReadTextFile(log_);      \
+  } while (0)
+
+Reconstruction ModelWithSomeCameraModels() {
+  Reconstruction model = MakePlaneModel();
+  // The models 3.8 knows (ids 0-10) all load; keep the images on their PINHOLE cameras.
+  for (int id = 0; id <= 10; ++id) {
+    Camera camera;
+    camera.camera_id = 50 + id;
+    camera.model_id = id;
+    camera.width = 640;
+    camera.height = 480;
+    const int n = CameraModelById(id).num_params;
+    for (int k = 0; k < n; ++k) camera.params.push_back(k < 2 ? 500.0 + k / 3.0 : 1e-3 * k);
+    if (id == 7) camera.params[4] = 0.7;  // FOV omega
+    model.cameras[camera.camera_id] = camera;
+  }
+  // Poses with full-precision values.
+  for (auto& [id, image] : model.images) {
+    image.cam_from_world_rotation =
+        Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * id, Eigen::Vector3d(1, 2, 3).normalized()));
+    image.cam_from_world_translation += Eigen::Vector3d(1.0 / 3, -2.0 / 7, 0.1);
+  }
+  return model;
+}
+
+TEST(ColmapInterop, ModelsWrittenByColmapReadBackIdentically) {
+  REQUIRE_COLMAP();
+  const std::string dir = MakeTestDir("interop_models");
+  const Reconstruction model = ModelWithSomeCameraModels();
+  for (const ModelFormat ours : {ModelFormat::kBinary, ModelFormat::kText}) {
+    const std::string tag = ours == ModelFormat::kBinary ? "bin" : "txt";
+    const std::string input = JoinPaths(dir, "ours_" + tag);
+    WriteReconstruction(model, input, ours);
+    for (const std::string type : {"BIN", "TXT"}) {
+      const std::string output = JoinPaths(dir, "colmap_from_" + tag + "_" + type);
+      CreateDirs(output);
+      // COLMAP reads our model (bin or txt) and writes it back in its own format.
+      EXPECT_COLMAP_OK("model_converter --input_path " + input + " --output_path " + output +
+                           " --output_type " + type,
+                       dir);
+      const Reconstruction read = ReadReconstruction(output);
+      // Exact but for the quaternions, which COLMAP 3.8 normalises again when reading and
+      // writing (a change of one ulp).
+      ExpectModelsEqual(model, read, 1e-15);
+      // COLMAP 3.8 writes images in hash-map order: image_order is that file order.
+      EXPECT_EQ(read.image_order.size(), model.images.size());
+    }
+  }
+  // COLMAP's BIN and TXT of the same model read back identically.
+  ExpectModelsEqual(ReadReconstruction(JoinPaths(dir, "colmap_from_txt_BIN")),
+                    ReadReconstruction(JoinPaths(dir, "colmap_from_txt_TXT")), 0.0);
+}
+
+TEST(ColmapInterop, ColmapRejectsWhatWeReject) {
+  REQUIRE_COLMAP();
+  // A PINHOLE camera with 3 parameters: COLMAP aborts, we throw naming the file and line.
+  const std::string dir = MakeTestDir("interop_reject");
+  const std::string model_dir = JoinPaths(dir, "model");
+  WriteReconstruction(MakePlaneModel(), model_dir, ModelFormat::kText);
+  WriteFileAtomically(JoinPaths(model_dir, "cameras.txt"),
+                      [](std::ostream& out) { out << "1 PINHOLE 64 48 50 50 32\n"; });
+  CreateDirs(JoinPaths(dir, "out"));
+  EXPECT_NE(RunColmap("model_converter --input_path " + model_dir + " --output_path " +
+                          JoinPaths(dir, "out") + " --output_type BIN",
+                      JoinPaths(dir, "colmap.log")),
+            0);
+  EXPECT_THROW(ReadReconstruction(model_dir), Error);
+}
+
+// A tilted plane z = 5 + 0.2 x seen by PINHOLE views with identity rotation.
+constexpr double kPlaneZ = 5.0;
+constexpr double kPlaneSlope = 0.2;
+
+double PlaneDistance(const Eigen::Vector3d& x) {
+  return std::abs(x.z() - kPlaneZ - kPlaneSlope * x.x()) / std::sqrt(1 + kPlaneSlope * kPlaneSlope);
+}
+
+// Depth and normal maps of the plane in COLMAP's MVS pixel convention (pixel (c, r) is
+// back-projected through image point (c, r), section 2).
+void WritePlaneMaps(const Workspace& ws) {
+  for (const std::string& name : ws.ImageNames()) {
+    const Image& image = ws.ImageByName(name);
+    const Camera& camera = ws.CameraOf(name);
+    const Eigen::Matrix3d K = camera.CalibrationMatrix();
+    const Eigen::Vector3d centre = image.ProjectionCenter();
+    FloatMap depth(static_cast<int>(camera.width), static_cast<int>(camera.height), 1);
+    FloatMap normal(depth.Width(), depth.Height(), 3);
+    const Eigen::Vector3d n = Eigen::Vector3d(kPlaneSlope, 0, -1).normalized();  // faces cameras
+    for (int r = 0; r < depth.Height(); ++r) {
+      for (int c = 0; c < depth.Width(); ++c) {
+        const double x = (c - K(0, 2)) / K(0, 0);
+        // centre.z + d = kPlaneZ + slope * (centre.x + d x)
+        const double d = (kPlaneZ + kPlaneSlope * centre.x() - centre.z()) / (1 - kPlaneSlope * x);
+        depth.At(r, c) = static_cast<float>(d);
+        for (int k = 0; k < 3; ++k) normal.At(r, c, k) = static_cast<float>(n[k]);
+      }
+    }
+    WriteMat(ws.DepthMapPath(name), depth);
+    WriteMat(ws.NormalMapPath(name), normal);
+  }
+  WriteFusionConfig(JoinPaths(ws.StereoPath(), "fusion.cfg"), ws.ImageNames());
+}
+
+TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
+  REQUIRE_COLMAP();
+  const std::string dir = MakeTestDir("interop_fusion");
+  testing_util::PlaneModelOptions options;
+  options.centres = {{0, 0, 0}, {0.5, 0, 0}, {0, 0.5, 0}};
+  testing_util::WriteTestWorkspace(dir, MakePlaneModel(options));
+  const Workspace ws = Workspace::Read(dir);
+  WritePlaneMaps(ws);
+  const std::string fused = JoinPaths(dir, "fused.ply");
+  EXPECT_COLMAP_OK("stereo_fusion --workspace_path " + dir +
+                       " --input_type geometric --output_path " + fused +
+                       " --StereoFusion.min_num_pixels 2 --StereoFusion.num_threads 1",
+                   dir);
+  const std::vector<FusedPoint> points = ReadFusedPly(fused);
+  // Each view sees 64 x 48 pixels; the overlaps are 54 or 59 columns / 38 rows wide, so
+  // COLMAP's greedy fusion yields well over 1000 points.
+  ASSERT_GT(points.size(), 1000u);
+  const Eigen::Vector3f plane_normal = Eigen::Vector3f(kPlaneSlope, 0, -1).normalized();
+  double max_distance = 0;
+  for (const FusedPoint& p : points) {
+    max_distance = std::max(max_distance, PlaneDistance(p.xyz.cast<double>()));
+    EXPECT_LT((p.normal - plane_normal).norm(), 1e-4);
+    ASSERT_GE(p.visible_image_idxs.size(), 2u);
+    for (uint32_t idx : p.visible_image_idxs) EXPECT_LT(idx, 3u);
+  }
+  // Each fused point is the per-coordinate median of back-projected pixels that all lie on
+  // the plane (within float32 rounding, about 5e-7 m at 5 m); a median of points on a tilted
+  // plane need not lie on it, but the fused pixels nearly coincide: 1e-4 m is 1/1000 of the
+  // pixel footprint (0.1 m at 5 m, f = 50 px).
+  EXPECT_LT(max_distance, 1e-4) << "max distance to the true plane (m)";
+  RecordProperty("max_plane_distance_m", Format(max_distance));
+  RecordProperty("num_fused_points", std::to_string(points.size()));
+
+  // Writing COLMAP's points back with WriteFusedPly gives byte-identical files.
+  const std::string ours = JoinPaths(dir, "ours.ply");
+  WriteFusedPly(ours, points);
+  EXPECT_EQ(ReadTextFile(ours), ReadTextFile(fused));
+  EXPECT_EQ(ReadTextFile(ours + ".vis"), ReadTextFile(fused + ".vis"));
+}
+
+TEST(ColmapInterop, PoissonMesherAcceptsOurFusedPly) {
+  REQUIRE_COLMAP();
+  const std::string dir = MakeTestDir("interop_poisson");
+  // Points on a sphere of radius 1 with outward normals.
+  std::vector<FusedPoint> points;
+  const int n = 3000;
+  for (int i = 0; i < n; ++i) {
+    // Fibonacci sphere.
+    const double z = 1 - 2 * (i + 0.5) / n;
+    const double radius = std::sqrt(1 - z * z);
+    const double phi = i * M_PI * (3 - std::sqrt(5.0));
+    FusedPoint p;
+    p.xyz = Eigen::Vector3f(radius * std::cos(phi), radius * std::sin(phi), z);
+    p.normal = p.xyz;
+    p.rgb[0] = 200;
+    p.visible_image_idxs = {0};
+    points.push_back(p);
+  }
+  const std::string ply = JoinPaths(dir, "fused.ply");
+  WriteFusedPly(ply, points);
+  const std::string mesh_path = JoinPaths(dir, "meshed-poisson.ply");
+  EXPECT_COLMAP_OK("poisson_mesher --input_path " + ply + " --output_path " + mesh_path +
+                       " --PoissonMeshing.depth 6 --PoissonMeshing.trim 0 "
+                       "--PoissonMeshing.num_threads 1",  // OpenMP threads spin on a loaded machine
+                   dir);
+  const TriangleMesh mesh = ReadMeshPly(mesh_path);
+  ASSERT_GT(mesh.vertices.size(), 100u);
+  ASSERT_GT(mesh.faces.size(), 100u);
+  EXPECT_EQ(mesh.colors.size(), mesh.vertices.size());
+  double max_error = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    max_error = std::max(max_error, std::abs(static_cast<double>(v.norm()) - 1.0));
+  }
+  // Octree depth 6 over the unit sphere: cells of about 2/64 m.
+  EXPECT_LT(max_error, 0.05);
+  RecordProperty("poisson_max_radius_error", Format(max_error));
+  // And our mesh writer's output reads back the same.
+  WriteMeshPly(JoinPaths(dir, "copy.ply"), mesh);
+  const TriangleMesh copy = ReadMeshPly(JoinPaths(dir, "copy.ply"));
+  EXPECT_EQ(copy.vertices, mesh.vertices);
+  EXPECT_EQ(copy.faces, mesh.faces);
+}
+
+}  // namespace
+}  // namespace hairmvs
