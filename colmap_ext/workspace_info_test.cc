@@ -1,0 +1,59 @@
+#include "colmap_ext/workspace_info.h"
+
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_ext/test_util.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+
+namespace hairmvs {
+namespace {
+
+TEST(WorkspaceInfo, SyntheticWorkspace) {
+  const std::string dir = testing_util::MakeTestDir("info");
+  testing_util::PlaneModelOptions options;
+  options.plane_z_m = 2.0;
+  options.centres = {{0, 0, 0}, {-0.1, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}};
+  testing_util::WriteTestWorkspace(dir, testing_util::MakePlaneModel(options));
+  CreateDirs(JoinPaths(dir, "masks"));
+  cv::Mat mask(48, 64, CV_8U, cv::Scalar(0));
+  mask(cv::Rect(0, 0, 32, 48)).setTo(255);
+  ASSERT_TRUE(cv::imwrite(JoinPaths(dir, "masks", "a.png.png"), mask));
+
+  const WorkspaceInfo info = ComputeWorkspaceInfo(dir, "", SourceViewOptions());
+  ASSERT_EQ(info.views.size(), 4u);
+  EXPECT_EQ(info.views[0].mask_path, JoinPaths(dir, "masks", "a.png.png"));
+  EXPECT_DOUBLE_EQ(info.views[0].mask_keep_fraction, 0.5);
+  EXPECT_TRUE(info.views[1].mask_path.empty());
+  EXPECT_GT(info.views[0].depth_range.min_m, 0);
+  EXPECT_EQ(info.selections.size(), 4u);
+  EXPECT_EQ(info.num_t_groups, 1);
+  const std::string report = info.Report();
+  for (const char* part : {"4 views", "PINHOLE 64x48", "fx 50", "[T group]", "why:",
+                           "mask 0.500", "workspace_info took"}) {
+    EXPECT_NE(report.find(part), std::string::npos) << part << "\n" << report;
+  }
+}
+
+TEST(WorkspaceInfo, SharedGantrySetHasEightTGroups) {
+  const std::string dir = JoinPaths(HAIRMVS_SHARED_DATA_DIR, "synth_straight_gantry", "dense");
+  if (!ExistsDir(dir)) GTEST_SKIP() << "shared data set not found: " << dir;
+  const WorkspaceInfo info = ComputeWorkspaceInfo(dir, "", SourceViewOptions());
+  // The rig: 8 groups of 4 views in a T (data README); every centre view's T is recognised.
+  ASSERT_EQ(info.views.size(), 32u);
+  EXPECT_EQ(info.num_t_groups, 8);
+  for (const SourceViewSelection& s : info.selections) {
+    const bool centre = s.reference.find("_c.png") != std::string::npos;
+    EXPECT_EQ(s.gantry_t_group, centre) << s.reference << ": " << s.reason;
+    EXPECT_LE(s.sources.size(), 4u);
+  }
+  for (const WorkspaceInfoViewRow& v : info.views) {
+    EXPECT_FALSE(v.mask_path.empty()) << v.name;
+    EXPECT_GT(v.depth_range.min_m, 0) << v.name;
+  }
+}
+
+}  // namespace
+}  // namespace hairmvs
