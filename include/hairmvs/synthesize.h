@@ -1,0 +1,84 @@
+#pragma once
+// The synthetic hair data set generator: procedural strands on an ellipsoidal head, rendered on
+// the CPU from a camera rig, written with exact ground truth in the layout of the shared data
+// sets (/work/shared/data/README.md): <output>/dense (a COLMAP dense workspace with the true
+// poses, sparse points with tracks, masks) and <output>/gt (per-view depth and labels, cameras,
+// strands, meta.json, pictures).
+
+#include <string>
+
+namespace hairmvs {
+
+enum class HairStyle { kStraight, kCurly };
+std::string ToString(HairStyle style);
+bool FromString(const std::string& text, HairStyle* style);
+
+enum class CameraRigType { kGantry, kHandheld };
+std::string ToString(CameraRigType rig);
+bool FromString(const std::string& text, CameraRigType* rig);
+
+struct SynthesizeOptions {
+  std::string output_path;
+  HairStyle style = HairStyle::kStraight;
+  // gantry: the paper's T groups of 4 (centre, left/right 10 degrees apart in azimuth, bottom
+  // 10 degrees lower) at 0.6 m from the hair; handheld: views around the head at varied
+  // distance, elevation and small roll.
+  CameraRigType rig = CameraRigType::kGantry;
+  // Gantry groups (1..8, in the order of the shared set: back, back-left, back-right, top...).
+  int num_groups = 1;
+  // Handheld views; 0 = 4 * num_groups.
+  int num_views = 0;
+  // Image width; height = round(2/3 width), focal = 0.79977 width (the shared sets' lens).
+  int width = 480;
+  int seed = 1;
+  // Strands: fewer than the shared sets' 40 000 so that a set is made in seconds; at width 480
+  // a pixel covers ~1.6 mm at 0.6 m, so the hair still looks dense.
+  int num_strands = 12000;
+  double hair_root_diameter_m = 0.00016;
+  double hair_tip_diameter_m = 0.00008;
+  // Head-proxy supersampling per axis (its silhouette); the sub-pixel strands are anti-aliased
+  // analytically (coverage = projected width x length).
+  int head_supersampling = 3;
+  // Sparse points sampled per view before the >= 2-view visibility test.
+  int sparse_samples_per_view = 400;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("output_path", &output_path, "folder to write dense/ and gt/ into");
+    v("style", &style, "straight or curly");
+    v("rig", &rig, "gantry (T groups of 4) or handheld");
+    v("num_groups", &num_groups, "gantry: number of T groups (1..8)");
+    v("num_views", &num_views, "handheld: number of views (0 = 4 * num_groups)");
+    v("width", &width, "image width in pixels (height = 2/3 width)");
+    v("seed", &seed, "random seed (same seed, same bytes)");
+    v("num_strands", &num_strands, "number of hair strands");
+    v("hair_root_diameter_m", &hair_root_diameter_m, "strand diameter at the root (m)");
+    v("hair_tip_diameter_m", &hair_tip_diameter_m, "strand diameter at the tip (m)");
+    v("head_supersampling", &head_supersampling, "head/background samples per pixel axis");
+    v("sparse_samples_per_view", &sparse_samples_per_view,
+      "candidate sparse points sampled per view");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct SynthesizeResult {
+  int num_views = 0;
+  int width = 0;
+  int height = 0;
+  int num_strands = 0;
+  int num_strand_points = 0;
+  int num_sparse_points = 0;
+  double mean_track_length = 0;
+  double hair_pixel_fraction = 0;  // hair-labelled pixels over all pixels, all views
+  double seconds_hair = 0;
+  double seconds_render = 0;
+  double seconds_write = 0;
+  double seconds_total = 0;
+  std::string BriefReport() const;
+};
+
+// Generates the data set under options.output_path (folders created; files written
+// atomically). Throws hairmvs::Error for invalid options or unwritable paths.
+SynthesizeResult RunSynthesize(const SynthesizeOptions& options);
+
+}  // namespace hairmvs

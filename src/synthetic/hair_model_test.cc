@@ -1,0 +1,115 @@
+#include "src/synthetic/hair_model.h"
+
+#include <gtest/gtest.h>
+
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace {
+
+TEST(SplitMix64, DeterministicAndInRange) {
+  SplitMix64 a(42), b(42), c(43);
+  bool differs = false;
+  for (int i = 0; i < 1000; ++i) {
+    const double x = a.Uniform();
+    EXPECT_EQ(x, b.Uniform());
+    differs |= x != c.Uniform();
+    EXPECT_GE(x, 0.0);
+    EXPECT_LT(x, 1.0);
+  }
+  EXPECT_TRUE(differs);
+  EXPECT_NE(DeriveSeed(1, 1, 0), DeriveSeed(1, 1, 1));
+  EXPECT_NE(DeriveSeed(1, 1, 0), DeriveSeed(2, 1, 0));
+}
+
+TEST(HeadModel, IntersectAndNormal) {
+  HeadModel head;
+  // From +Y straight at the centre: hits the back of the head at y = b.
+  const double t = head.Intersect(Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, -1, 0));
+  EXPECT_NEAR(t, 1.0 - 0.10, 1e-12);
+  EXPECT_LT(head.Intersect(Eigen::Vector3d(0, 1, 0), Eigen::Vector3d(0, 1, 0)), 0.0);
+  EXPECT_TRUE(head.Normal(Eigen::Vector3d(0, 0, 0.11)).isApprox(Eigen::Vector3d::UnitZ()));
+  EXPECT_NEAR(head.ShellValue(Eigen::Vector3d(0.08, 0, 0), 0.0), 1.0, 1e-12);
+}
+
+HairStrands SmallHair(HairStyle style, uint64_t seed) {
+  HairGenerationOptions options;
+  options.style = style;
+  options.num_strands = 300;
+  options.seed = seed;
+  return GenerateHair(HeadModel(), options);
+}
+
+TEST(GenerateHair, RootsOnScalpPointsOutsideHeadDeterministic) {
+  const HeadModel head;
+  for (HairStyle style : {HairStyle::kStraight, HairStyle::kCurly}) {
+    const HairStrands hair = SmallHair(style, 7);
+    ASSERT_EQ(hair.NumStrands(), 300);
+    ASSERT_EQ(hair.offsets.back(), static_cast<int64_t>(hair.points.size()));
+    for (int s = 0; s < hair.NumStrands(); ++s) {
+      ASSERT_GT(hair.offsets[s + 1] - hair.offsets[s], 10);
+      const Eigen::Vector3d root = hair.points[hair.offsets[s]].cast<double>();
+      EXPECT_NEAR(head.ShellValue(root, 0.0), 1.0, 1e-5);
+      // Roots on the upper part: not below the nape's hairline.
+      EXPECT_GT(root.z(), -0.05);
+      for (int64_t i = hair.offsets[s] + 1; i < hair.offsets[s + 1]; ++i) {
+        EXPECT_GE(head.ShellValue(hair.points[i].cast<double>(), 0.0), 1.0 - 1e-4);
+      }
+      // Hair falls: the tip is below the root.
+      EXPECT_LT(hair.points[hair.offsets[s + 1] - 1].z(), root.z());
+    }
+    const HairStrands again = SmallHair(style, 7);
+    EXPECT_EQ(again.points, hair.points);
+    const HairStrands other = SmallHair(style, 8);
+    EXPECT_NE(other.points, hair.points);
+  }
+}
+
+// Curls make a strand much longer than the distance it covers.
+TEST(GenerateHair, CurlyIsTortuous) {
+  auto tortuosity = [](const HairStrands& hair) {
+    double length = 0, span = 0;
+    for (int s = 0; s < hair.NumStrands(); ++s) {
+      for (int64_t i = hair.offsets[s]; i + 1 < hair.offsets[s + 1]; ++i) {
+        length += (hair.points[i + 1] - hair.points[i]).norm();
+      }
+      span += (hair.points[hair.offsets[s + 1] - 1] - hair.points[hair.offsets[s]]).norm();
+    }
+    return length / span;
+  };
+  const double straight = tortuosity(SmallHair(HairStyle::kStraight, 3));
+  const double curly = tortuosity(SmallHair(HairStyle::kCurly, 3));
+  EXPECT_LT(straight, 1.6);
+  EXPECT_GT(curly, straight + 0.5);
+}
+
+TEST(DensifyStrands, KeepsStoredPointsFollowsSplineAndTapers) {
+  const HairStrands hair = SmallHair(HairStyle::kCurly, 5);
+  const double spacing = 0.0008;
+  const DenseStrands dense = DensifyStrands(hair, spacing, 1.6e-4, 0.8e-4);
+  ASSERT_EQ(dense.offsets.size(), hair.offsets.size());
+  for (int s = 0; s < hair.NumStrands(); s += 17) {
+    // Every stored point is a dense point, in order.
+    int64_t j = dense.offsets[s];
+    for (int64_t i = hair.offsets[s]; i < hair.offsets[s + 1]; ++i) {
+      while (j < dense.offsets[s + 1] && dense.points[j] != hair.points[i]) ++j;
+      ASSERT_LT(j, dense.offsets[s + 1]) << "stored point " << i << " missing";
+    }
+    EXPECT_NEAR(dense.radius_m[dense.offsets[s]], 0.8e-4, 1e-9);
+    EXPECT_NEAR(dense.radius_m[dense.offsets[s + 1] - 1], 0.4e-4, 1e-9);
+    for (int64_t k = dense.offsets[s]; k + 1 < dense.offsets[s + 1]; ++k) {
+      EXPECT_EQ(dense.strand[k], s);
+      EXPECT_LT((dense.points[k + 1] - dense.points[k]).norm(), 2.0 * spacing);
+    }
+  }
+  // The dense points lie on the uniform Catmull-Rom spline of the evaluation code: its
+  // midpoints of the first segment of strand 0 match.
+  const Eigen::Vector3d p0 = hair.points[0].cast<double>(), p1 = hair.points[1].cast<double>(),
+                        p2 = hair.points[2].cast<double>();
+  const Eigen::Vector3d on_spline = CatmullRom(p0, p0, p1, p2, 0.5);
+  const double d = DistanceToPolyline(dense.points, dense.offsets[0], dense.offsets[1], on_spline);
+  EXPECT_LT(d, 2e-5);
+}
+
+}  // namespace
+}  // namespace hairmvs
