@@ -16,6 +16,49 @@
 #error "NUM_LABELS must be defined"
 #endif
 
+// m[b] = min_a prev[a] + weight * min((a * step - (delta + b * step))^2, truncation) with the
+// lower envelope of parabolas (Felzenszwalb and Huttenlocher 2004), O(L). The twin of
+// SemiGlobalPathMin in src/mrf/semi_global.cc (same arithmetic order).
+inline void sgm_path_min(const float* prev, float prev_min, float step, float delta, float weight,
+                         float truncation, float* m) {
+  if (!(weight > 0.0f)) {
+    for (int b = 0; b < NUM_LABELS; ++b) m[b] = prev_min;
+    return;
+  }
+  int v[NUM_LABELS];
+  float z[NUM_LABELS + 1];
+  int k = 0;
+  v[0] = 0;
+  z[0] = -INFINITY;
+  z[1] = INFINITY;
+  for (int a = 1; a < NUM_LABELS; ++a) {
+    const float xa = (float)a * step;
+    const float ha = prev[a] + weight * (xa * xa);
+    for (;;) {
+      const float xc = (float)v[k] * step;
+      const float hc = prev[v[k]] + weight * (xc * xc);
+      const float s = (ha - hc) / (2.0f * weight * (xa - xc));
+      if (k > 0 && s <= z[k]) {
+        --k;
+        continue;
+      }
+      ++k;
+      v[k] = a;
+      z[k] = s;
+      z[k + 1] = INFINITY;
+      break;
+    }
+  }
+  const float truncated = prev_min + weight * truncation;
+  k = 0;
+  for (int b = 0; b < NUM_LABELS; ++b) {
+    const float y = delta + (float)b * step;
+    while (z[k + 1] < y) ++k;
+    const float d = y - (float)v[k] * step;
+    m[b] = fmin(prev[v[k]] + weight * (d * d), truncated);
+  }
+}
+
 __kernel void sgm_path(__global const float* cost, __global const float* offset, float step,
                        __global const float* weight, float truncation, int width, int height,
                        int dx, int dy, int num_paths, __global float* sum) {
@@ -40,8 +83,10 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
   const int n = width * height;
   float prev[NUM_LABELS];
   float cur[NUM_LABELS];
+  float m[NUM_LABELS];
   int p = row * width + col;
   float prev_min = INFINITY;
+#pragma unroll
   for (int b = 0; b < NUM_LABELS; ++b) {
     prev[b] = cost[b * n + p];
     prev_min = fmin(prev_min, prev[b]);
@@ -57,18 +102,13 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
     p = row * width + col;
     const float w = weight[upper_is_prev ? q : p];
     const float cur_offset = offset[p];
+    sgm_path_min(prev, prev_min, step, cur_offset - prev_offset, w, truncation, m);
     float cur_min = INFINITY;
     for (int b = 0; b < NUM_LABELS; ++b) {
-      const float vp = cur_offset + (float)b * step;
-      float best = INFINITY;
-      for (int a = 0; a < NUM_LABELS; ++a) {
-        const float d = (prev_offset + (float)a * step) - vp;
-        const float c = prev[a] + w * fmin(d * d, truncation);
-        best = fmin(best, c);
-      }
-      cur[b] = cost[b * n + p] + (best - prev_min);
+      cur[b] = cost[b * n + p] + (m[b] - prev_min);
       cur_min = fmin(cur_min, cur[b]);
     }
+#pragma unroll
     for (int b = 0; b < NUM_LABELS; ++b) {
       prev[b] = cur[b];
       sum[b * n + p] += cur[b];

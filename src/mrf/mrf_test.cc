@@ -7,6 +7,7 @@
 
 #include "src/core/logging.h"
 #include "src/mrf/graph_cuts.h"
+#include "src/mrf/mrf_synthetic.h"
 #include "src/mrf/semi_global.h"
 #include "src/opencl/opencl_context.h"
 
@@ -29,55 +30,6 @@ MrfProblem RandomProblem(int width, int height, int num_labels, float max_weight
   for (size_t p = 0; p < n; ++p) {
     problem.weight_right[p] = max_weight * unit(rng);
     problem.weight_down[p] = max_weight * unit(rng);
-  }
-  return problem;
-}
-
-// Stereo-like: a smooth true depth (a slanted plane plus a bump, in label units), a data term
-// (value - true)^2 capped at 1 plus noise, 10% of the pixels with pure-noise costs (as where
-// orientations do not match), and orientation-like weights exp(-|dO|^2 / (2 * 0.15^2)) scaled
-// by lambda, from a random smooth orientation field with a few discontinuities.
-MrfProblem StereoLikeProblem(int width, int height, int num_labels, float lambda, uint32_t seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  MrfProblem problem;
-  problem.width = width;
-  problem.height = height;
-  problem.num_labels = num_labels;
-  const size_t n = problem.NumPixels();
-  problem.data_cost.resize(n * num_labels);
-  std::vector<float> theta(n);
-  for (int row = 0; row < height; ++row) {
-    for (int col = 0; col < width; ++col) {
-      const size_t p = static_cast<size_t>(row) * width + col;
-      const float x = (col + 0.5f) / width;
-      const float y = (row + 0.5f) / height;
-      const float r2 = (x - 0.5f) * (x - 0.5f) + (y - 0.5f) * (y - 0.5f);
-      const float truth =
-          (num_labels - 1) * (0.2f + 0.4f * x + 0.1f * y + 0.3f * std::exp(-r2 / 0.02f));
-      const bool outlier = unit(rng) < 0.1f;
-      for (int l = 0; l < num_labels; ++l) {
-        const float d = l - truth;
-        problem.data_cost[l * n + p] =
-            outlier ? unit(rng) : std::min(0.25f * d * d, 1.0f) + 0.3f * unit(rng);
-      }
-      theta[p] = (x > 0.6f ? 1.2f : 0.2f) + 0.3f * y + 0.05f * unit(rng);
-    }
-  }
-  problem.weight_right.assign(n, 0.0f);
-  problem.weight_down.assign(n, 0.0f);
-  auto weight = [&](size_t p, size_t q) {
-    // |O(p) - O(q)| for unit complex orientations e^{2 i theta}.
-    const float dre = std::cos(2 * theta[p]) - std::cos(2 * theta[q]);
-    const float dim = std::sin(2 * theta[p]) - std::sin(2 * theta[q]);
-    return lambda * std::exp(-(dre * dre + dim * dim) / (2 * 0.15f * 0.15f));
-  };
-  for (int row = 0; row < height; ++row) {
-    for (int col = 0; col < width; ++col) {
-      const size_t p = static_cast<size_t>(row) * width + col;
-      if (col + 1 < width) problem.weight_right[p] = weight(p, p + 1);
-      if (row + 1 < height) problem.weight_down[p] = weight(p, p + width);
-    }
   }
   return problem;
 }
@@ -230,7 +182,7 @@ TEST(GraphCuts, NonSubmodularMovesNeverIncreaseTheEnergy) {
 TEST(GraphCuts, StereoLikeProblemsAgainstOtherSolvers) {
   for (int num_labels : {8, 16}) {
     for (float lambda : {0.2f, 1.0f}) {
-      const MrfProblem problem = StereoLikeProblem(24, 20, num_labels, lambda, 7 + num_labels);
+      const MrfProblem problem = SyntheticStereoMrfProblem(24, 20, num_labels, lambda, 7 + num_labels);
       const double wta = MrfEnergy(problem, WinnerTakeAll(problem));
       const MrfResult gc = Solve(problem, MrfSolverType::kGraphCuts);
       EXPECT_LT(gc.energy, wta);
@@ -295,6 +247,37 @@ TEST(MrfProblem, LabelOffsetsMatchTheEquivalentProblemWithoutOffsets) {
   EXPECT_LE(gc_full.energy, optimum * 1.05 + 1e-9);
 }
 
+// The O(L) lower-envelope minimum of a path step equals the O(L^2) brute force.
+TEST(SemiGlobal, PathMinimumEqualsBruteForce) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const int num_labels = 1 + trial % 33;
+    std::vector<float> prev(num_labels);
+    for (float& x : prev) x = (trial % 3 == 0 ? 100.0f : 3.0f) * unit(rng);
+    const float prev_min = *std::min_element(prev.begin(), prev.end());
+    const float step = 0.1f + 2.0f * unit(rng);
+    const float delta = (unit(rng) - 0.5f) * 3.0f * step * num_labels;
+    const float weight = trial % 7 == 0 ? 0.0f : std::pow(10.0f, 4.0f * unit(rng) - 2.0f);
+    const float truncation = trial % 2 ? 1e30f : 5.0f * unit(rng) * step * step;
+    std::vector<int> v(num_labels);
+    std::vector<float> z(num_labels + 1);
+    std::vector<float> m(num_labels);
+    SemiGlobalPathMin(prev.data(), prev_min, num_labels, step, delta, weight, truncation,
+                      v.data(), z.data(), m.data());
+    for (int b = 0; b < num_labels; ++b) {
+      double best = std::numeric_limits<double>::infinity();
+      for (int a = 0; a < num_labels; ++a) {
+        const double d = static_cast<double>(a) * step - (delta + static_cast<double>(b) * step);
+        best = std::min(best, prev[a] + static_cast<double>(weight) *
+                                            std::min(d * d, static_cast<double>(truncation)));
+      }
+      ASSERT_NEAR(m[b], best, 1e-4 * (1.0 + std::abs(best)))
+          << "trial " << trial << " L " << num_labels << " b " << b;
+    }
+  }
+}
+
 // The OpenCL semi-global matching (with and without the ICM polish on the device) equals its
 // CPU reference.
 TEST(SemiGlobal, OpenCLMatchesCpuReference) {
@@ -302,7 +285,7 @@ TEST(SemiGlobal, OpenCLMatchesCpuReference) {
     for (int variant = 0; variant < 4; ++variant) {
       const int icm = variant == 3 ? 20 : 0;
       MrfProblem problem = variant == 0 ? RandomProblem(23, 17, 5, 0.5f, 5)
-                                        : StereoLikeProblem(24, 20, 12, 0.5f, 9);
+                                        : SyntheticStereoMrfProblem(24, 20, 12, 0.5f, 9);
       if (variant >= 2) {
         problem.truncation = 4.0f;
         problem.label_step = 0.25f;

@@ -30,6 +30,48 @@ const std::vector<float>& DirectionWeights(const SemiGlobalEdgeWeights& weights,
 
 }  // namespace
 
+void SemiGlobalPathMin(const float* prev, float prev_min, int num_labels, float step, float delta,
+                       float weight, float truncation, int* v, float* z, float* m) {
+  // The same float arithmetic, in the same order, as sgm_path_min in kernels/mrf_sgm.cl.
+  const float kInf = std::numeric_limits<float>::infinity();
+  if (!(weight > 0.0f)) {
+    for (int b = 0; b < num_labels; ++b) m[b] = prev_min;
+    return;
+  }
+  // Lower envelope of f_a(y) = prev[a] + weight * (y - a * step)^2: v[0..k] are the parabolas
+  // on it, z[i] where parabola v[i] starts being the lowest.
+  int k = 0;
+  v[0] = 0;
+  z[0] = -kInf;
+  z[1] = kInf;
+  for (int a = 1; a < num_labels; ++a) {
+    const float xa = static_cast<float>(a) * step;
+    const float ha = prev[a] + weight * (xa * xa);
+    for (;;) {
+      const float xc = static_cast<float>(v[k]) * step;
+      const float hc = prev[v[k]] + weight * (xc * xc);
+      const float s = (ha - hc) / (2.0f * weight * (xa - xc));
+      if (k > 0 && s <= z[k]) {
+        --k;
+        continue;
+      }
+      ++k;
+      v[k] = a;
+      z[k] = s;
+      z[k + 1] = kInf;
+      break;
+    }
+  }
+  const float truncated = prev_min + weight * truncation;
+  k = 0;
+  for (int b = 0; b < num_labels; ++b) {
+    const float y = delta + static_cast<float>(b) * step;
+    while (z[k + 1] < y) ++k;
+    const float d = y - static_cast<float>(v[k]) * step;
+    m[b] = std::min(prev[v[k]] + weight * (d * d), truncated);
+  }
+}
+
 std::vector<std::array<int, 2>> SemiGlobalDirections(int num_directions) {
   CHECK(num_directions == 4 || num_directions == 8) << num_directions;
   std::vector<std::array<int, 2>> dirs = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
@@ -81,6 +123,9 @@ std::vector<int> SolveSemiGlobalCpu(const MrfProblem& problem, int num_direction
   std::vector<float> sum(n * num_labels, 0.0f);
   std::vector<float> prev(num_labels);
   std::vector<float> cur(num_labels);
+  std::vector<float> m(num_labels);
+  std::vector<float> z(num_labels + 1);
+  std::vector<int> v(num_labels);
   const float kInf = std::numeric_limits<float>::infinity();
 
   for (const auto& dir : SemiGlobalDirections(num_directions)) {
@@ -123,16 +168,11 @@ std::vector<int> SolveSemiGlobalCpu(const MrfProblem& problem, int num_direction
         p = static_cast<size_t>(row) * width + col;
         const float w = weight[upper_is_prev ? q : p];
         const float cur_offset = offset[p];
+        SemiGlobalPathMin(prev.data(), prev_min, num_labels, step, cur_offset - prev_offset, w,
+                          truncation, v.data(), z.data(), m.data());
         float cur_min = kInf;
         for (int b = 0; b < num_labels; ++b) {
-          const float vp = cur_offset + static_cast<float>(b) * step;
-          float best = kInf;
-          for (int a = 0; a < num_labels; ++a) {
-            const float d = (prev_offset + static_cast<float>(a) * step) - vp;
-            const float c = prev[a] + w * std::min(d * d, truncation);
-            best = std::min(best, c);
-          }
-          cur[b] = cost[b * n + p] + (best - prev_min);
+          cur[b] = cost[b * n + p] + (m[b] - prev_min);
           cur_min = std::min(cur_min, cur[b]);
         }
         for (int b = 0; b < num_labels; ++b) {

@@ -3,7 +3,9 @@
 // scanline directions r, the 1-D dynamic programme
 //   L_r(p, b) = C(p, b) + min_a [L_r(p - r, a) + V(a, b)] - min_a L_r(p - r, a)
 // with the MRF's own pairwise term V(a, b) = w * min((value(p-r, a) - value(p, b))^2, trunc)
-// (O(L^2) per pixel and direction), then label(p) = argmin_b sum_r L_r(p, b).
+// then label(p) = argmin_b sum_r L_r(p, b). The inner minimum is found in O(L) per pixel and
+// direction with the lower envelope of parabolas (Felzenszwalb and Huttenlocher 2004), as
+// min(envelope, min_a L_r(p - r, a) + w * trunc) for the truncated quadratic.
 // Diagonal directions use a weight derived from the 4-neighbour weights around the diagonal
 // (SemiGlobalEdgeWeights). Internal to hairmvs_mrf: callers use SolveMrf.
 
@@ -25,6 +27,13 @@ struct SemiGlobalEdgeWeights {
   std::vector<float> right, down, diag, anti;
 };
 SemiGlobalEdgeWeights ComputeSemiGlobalEdgeWeights(const MrfProblem& problem);
+
+// m[b] = min_a prev[a] + weight * min((a * step - (delta + b * step))^2, truncation), for
+// b = 0..num_labels-1, with the lower envelope of parabolas (O(L)); prev_min = min_a prev[a].
+// The CPU twin of sgm_path_min in kernels/mrf_sgm.cl. v, z: scratch of num_labels and
+// num_labels + 1 entries.
+void SemiGlobalPathMin(const float* prev, float prev_min, int num_labels, float step, float delta,
+                       float weight, float truncation, int* v, float* z, float* m);
 
 // Plain CPU reference (one path at a time, in the same arithmetic order as the kernel).
 std::vector<int> SolveSemiGlobalCpu(const MrfProblem& problem, int num_directions);
