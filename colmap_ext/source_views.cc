@@ -99,7 +99,8 @@ Eigen::Vector2d ImageCentre(const Reconstruction& model, const Image& image) {
 
 std::string FormatDeg(double rad) {
   std::ostringstream ss;
-  ss << std::fixed << std::setprecision(0) << RadToDeg(rad);
+  // Rounded to whole degrees, modulo 180 (179.6 prints as 0).
+  ss << std::fmod(std::round(RadToDeg(rad)), 180.0);
   return ss.str();
 }
 

@@ -1,5 +1,6 @@
 #include "colmap_ext/workspace_info.h"
 
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -103,7 +104,7 @@ std::string WorkspaceInfo::Report() const {
       if (k < s.shared_points.size()) {
         out << " (" << s.shared_points[k] << " pts, " << std::fixed << std::setprecision(1)
             << s.triangulation_angle_deg[k] << " deg, epi " << std::setprecision(0)
-            << s.epipolar_direction_deg[k] << ")";
+            << std::fmod(std::round(s.epipolar_direction_deg[k]), 180.0) << ")";
         out.unsetf(std::ios::fixed);
         out << std::setprecision(6);
       }

@@ -40,7 +40,8 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_EQ(ws.ImageByName("b.png").image_id, 2u);
   EXPECT_EQ(ws.CameraOf("b.png").CalibrationMatrix()(0, 0), 50.0);
   EXPECT_EQ(ws.ImagePath("a.png"), JoinPaths(dir, "images", "a.png"));
-  EXPECT_EQ(ws.DepthMapPath("a.png"), JoinPaths(dir, "stereo", "depth_maps", "a.png.geometric.bin"));
+  EXPECT_EQ(ws.DepthMapPath("a.png"),
+            JoinPaths(dir, "stereo", "depth_maps", "a.png.geometric.bin"));
   EXPECT_EQ(ws.NormalMapPath("a.png", "photometric"),
             JoinPaths(dir, "stereo", "normal_maps", "a.png.photometric.bin"));
   EXPECT_THROW(ws.DepthMapPath("a.png", "geometrical"), Error);
