@@ -22,6 +22,9 @@ struct ImportGroundTruthOptions {
   // Median-filter the true depth maps (k x k over the kept pixels, 0 = off) before writing:
   // the README's "ideal smooth surface" (7).
   int median_filter_px = 0;
+  // 1: a plain median (background zeros count; every pixel filtered, then the labels
+  // applied); 0: the median of the kept depths around each kept pixel.
+  bool median_include_background = true;
   // Copy images/ and masks/ instead of symlinking them.
   bool copy_images = false;
   // Empty: every image of the workspace.
@@ -34,6 +37,8 @@ struct ImportGroundTruthOptions {
     v("hair_only", &hair_only, "keep hair pixels only (else hair and head skin)");
     v("median_filter_px", &median_filter_px,
       "median-filter the true depths over a k x k window (0 = off; odd)");
+    v("median_include_background", &median_include_background,
+      "plain median with background zeros (1) or of the kept depths only (0)");
     v("copy_images", &copy_images, "copy images/ and masks/ instead of symlinking");
     v("image_names", &image_names, "views to write (comma-separated; empty = all)");
   }

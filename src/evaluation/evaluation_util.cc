@@ -34,7 +34,7 @@ DistanceStats SummarizeDistances(std::vector<double> distances_m) {
   return stats;
 }
 
-FloatMap MedianFilterValidDepths(const FloatMap& depth, int k) {
+FloatMap MedianFilterValidDepths(const FloatMap& depth, int k, bool include_invalid) {
   CHECK_EQ(depth.Channels(), 1);
   CHECK(k >= 1 && k % 2 == 1) << "median filter size must be odd";
   const int radius = k / 2;
@@ -46,12 +46,12 @@ FloatMap MedianFilterValidDepths(const FloatMap& depth, int k) {
     std::vector<float> window;
     window.reserve(k * k);
     for (int c = 0; c < width; ++c) {
-      if (!(depth.At(r, c) > 0)) continue;
+      if (!include_invalid && !(depth.At(r, c) > 0)) continue;
       window.clear();
       for (int rr = std::max(0, r - radius); rr <= std::min(height - 1, r + radius); ++rr) {
         for (int cc = std::max(0, c - radius); cc <= std::min(width - 1, c + radius); ++cc) {
           const float d = depth.At(rr, cc);
-          if (d > 0) window.push_back(d);
+          if (include_invalid || d > 0) window.push_back(d);
         }
       }
       const size_t n = window.size();

@@ -17,7 +17,10 @@ double Mean(const std::vector<double>& values);
 
 // k x k median of the valid (> 0) depths around each valid pixel (the median of an even
 // count is the mean of the two middle values); invalid pixels stay 0. k odd.
-FloatMap MedianFilterValidDepths(const FloatMap& depth, int k);
+// include_invalid: a plain median over every pixel of the window (zeros included, the
+// window clamped at the image border), computed for every pixel, like
+// scipy.ndimage.median_filter(depth, k) up to its border rule.
+FloatMap MedianFilterValidDepths(const FloatMap& depth, int k, bool include_invalid = false);
 
 // "Section.field" checks shared by the option structs.
 bool CheckImageNames(const std::vector<std::string>& names, std::string* error);

@@ -89,10 +89,11 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   THROW_IF(IsSameOrInside(output_path, workspace_path),
            "--output_path " << output_path << " is inside the workspace " << workspace_path
                             << ": import_ground_truth writes a new workspace");
-  THROW_IF(IsSameOrInside(output_path, ground_truth_path) ||
-               IsSameOrInside(output_path, ParentPath(fs::weakly_canonical(ground_truth_path))),
-           "--output_path " << output_path << " is inside the data set of "
-                            << ground_truth_path << ", which is read-only");
+  THROW_IF(IsSameOrInside(output_path, ground_truth_path),
+           "--output_path " << output_path << " is inside the ground truth folder "
+                            << ground_truth_path);
+  THROW_IF(IsSameOrInside(workspace_path, output_path),
+           "--output_path " << output_path << " contains the workspace " << workspace_path);
   const Workspace ws = Workspace::Read(workspace_path);
   std::vector<std::string> names = options.image_names;
   if (names.empty()) names = ws.ImageNames();
@@ -134,12 +135,20 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
                       << GroundTruthViewPath(ground_truth_path, name) << " is "
                       << view.depth.Width() << " x " << view.depth.Height());
     FloatMap depth = view.depth;
-    for (size_t p = 0; p < depth.NumPixels(); ++p) {
-      const uint8_t label = view.label[p];
-      const bool keep = label == kLabelHair || (!options.hair_only && label == kLabelSkin);
-      if (!keep) depth.Data()[p] = 0.0f;
+    auto apply_labels = [&](FloatMap* map) {
+      for (size_t p = 0; p < map->NumPixels(); ++p) {
+        const uint8_t label = view.label[p];
+        const bool keep = label == kLabelHair || (!options.hair_only && label == kLabelSkin);
+        if (!keep) map->Data()[p] = 0.0f;
+      }
+    };
+    if (options.median_filter_px > 1 && options.median_include_background) {
+      depth = MedianFilterValidDepths(depth, options.median_filter_px, true);
     }
-    if (options.median_filter_px > 1) depth = MedianFilterValidDepths(depth, options.median_filter_px);
+    apply_labels(&depth);
+    if (options.median_filter_px > 1 && !options.median_include_background) {
+      depth = MedianFilterValidDepths(depth, options.median_filter_px);
+    }
     for (float& d : depth.Data()) {
       if (d > 0) {
         ++kept;

@@ -1,0 +1,250 @@
+// import_ground_truth, evaluate_depth and evaluate_mesh on a tiny synthetic scene whose truth is
+// known in closed form: a plane of parallel straight strands 0.1 mm apart, seen by two cameras.
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <filesystem>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/ply.h"
+#include "colmap_ext/reconstruction.h"
+#include "hairmvs/evaluation.h"
+#include "src/core/depth_geometry.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace {
+
+constexpr int kWidth = 64;
+constexpr int kHeight = 48;
+constexpr double kPlaneZ = 0.5;       // world z of the hair plane
+constexpr double kStrandGap = 1e-4;   // strands 0.1 mm apart along world x
+constexpr double kHairHalfX = 0.03, kHairHalfY = 0.02;
+
+struct Scene {
+  std::string dir, gt, workspace;
+  GroundTruthCameras cameras;
+};
+
+Scene MakeScene(const std::string& name) {
+  Scene scene;
+  scene.dir = JoinPaths(::testing::TempDir(), "hairmvs_eval_" + name);
+  std::filesystem::remove_all(scene.dir);
+  scene.gt = JoinPaths(scene.dir, "gt");
+  scene.workspace = JoinPaths(scene.dir, "dense");
+  GroundTruthCameras& cameras = scene.cameras;
+  cameras.K << 400, 0, 32, 0, 400, 24, 0, 0, 1;
+  cameras.width = kWidth;
+  cameras.height = kHeight;
+  const Eigen::Vector3d centres[2] = {{0, 0, 0}, {-0.03, 0.01, 0.02}};
+  const double angles[2] = {0.0, -0.06};
+  Reconstruction model;
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model_id = 1;  // PINHOLE
+  camera.width = kWidth;
+  camera.height = kHeight;
+  camera.params = {400, 400, 32, 24};
+  model.cameras[1] = camera;
+  CreateDirs(JoinPaths(scene.workspace, "images"));
+  CreateDirs(JoinPaths(scene.workspace, "sparse"));
+  for (int i = 0; i < 2; ++i) {
+    const std::string image_name = "v" + std::to_string(i) + ".png";
+    const Eigen::Matrix3d R =
+        Eigen::AngleAxisd(angles[i], Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Vector3d t = -R * centres[i];
+    cameras.names.push_back(image_name);
+    cameras.R.push_back(R);
+    cameras.t.push_back(t);
+    Image image;
+    image.image_id = i + 1;
+    image.camera_id = 1;
+    image.name = image_name;
+    image.cam_from_world_rotation = Eigen::Quaterniond(R);
+    image.cam_from_world_translation = t;
+    model.images[image.image_id] = image;
+    cv::imwrite(JoinPaths(scene.workspace, "images", image_name),
+                cv::Mat(kHeight, kWidth, CV_8UC3, cv::Scalar(30, 40, 50)));
+    // The true depth: ray / plane intersection; hair inside a rectangle of the plane.
+    GroundTruthView view;
+    view.depth = FloatMap(kWidth, kHeight, 1, 0.0f);
+    view.label.assign(kWidth * kHeight, kLabelBackground);
+    for (int r = 0; r < kHeight; ++r) {
+      for (int c = 0; c < kWidth; ++c) {
+        const Eigen::Vector3d ray = R.transpose() * BackProjectPixel(cameras.K, c, r, 1.0);
+        const double s = (kPlaneZ - centres[i].z()) / ray.z();
+        const Eigen::Vector3d X = centres[i] + s * ray;
+        if (std::abs(X.x()) > kHairHalfX || std::abs(X.y()) > kHairHalfY) continue;
+        view.depth.At(r, c) = static_cast<float>((R * X + t).z());
+        view.label[r * kWidth + c] = kLabelHair;
+      }
+    }
+    WriteGroundTruthView(scene.gt, image_name, view);
+  }
+  model.SortImageOrder();
+  WriteReconstruction(model, JoinPaths(scene.workspace, "sparse"), ModelFormat::kText);
+  WriteGroundTruthCameras(scene.gt, cameras);
+  // Straight strands along y, points 6 mm apart, covering the hair rectangle and more.
+  GroundTruthStrands strands;
+  strands.offsets.push_back(0);
+  for (double x = -kHairHalfX - 0.005; x <= kHairHalfX + 0.005; x += kStrandGap) {
+    for (double y = -kHairHalfY - 0.006; y <= kHairHalfY + 0.006; y += 0.006) {
+      strands.points.emplace_back(x, y, kPlaneZ);
+    }
+    strands.offsets.push_back(strands.points.size());
+  }
+  WriteGroundTruthStrands(scene.gt, strands);
+  return scene;
+}
+
+DepthEvaluationOptions FastDepthOptions() {
+  DepthEvaluationOptions options;
+  options.strand_spacing_m = 2e-3;  // straight strands: the polyline is exact anyway
+  return options;
+}
+
+TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
+  const Scene scene = MakeScene("truth");
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruthOptions import_options;
+  const ImportGroundTruthResult imported =
+      ImportGroundTruth(scene.gt, scene.workspace, out, import_options);
+  EXPECT_EQ(imported.num_views, 2);
+  EXPECT_TRUE(std::filesystem::is_symlink(JoinPaths(out, "images")));
+  const FloatMap depth = ReadMat(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"));
+  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v1.png");
+  EXPECT_EQ(depth.Data(), truth.depth.Data());
+  // Normals of the plane z = 0.5 in camera 1's frame: R * (0, 0, -1).
+  const FloatMap normals =
+      ReadMat(JoinPaths(out, "stereo", "normal_maps", "v1.png.geometric.bin"));
+  const Eigen::Vector3d expected = scene.cameras.R[1] * Eigen::Vector3d(0, 0, -1);
+  const int r = kHeight / 2, c = kWidth / 2;
+  ASSERT_GT(depth.At(r, c), 0);
+  EXPECT_NEAR(normals.At(r, c, 0), expected.x(), 1e-3);
+  EXPECT_NEAR(normals.At(r, c, 2), expected.z(), 1e-3);
+
+  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, FastDepthOptions());
+  ASSERT_EQ(result.views.size(), 2u);
+  EXPECT_GT(result.overall.num_hair_pixels, 1000);
+  EXPECT_DOUBLE_EQ(result.overall.completeness, 1.0);
+  EXPECT_NEAR(result.overall.mean_abs_error_mm, 0.0, 1e-9);
+  EXPECT_DOUBLE_EQ(result.overall.within_1mm, 1.0);
+  // On the plane of strands 0.1 mm apart: at most 0.05 mm from one (float depths: + ~1e-4 mm).
+  EXPECT_LT(result.overall.accuracy_3d_mean_mm, 0.0502);
+  EXPECT_GT(result.overall.accuracy_3d_mean_mm, 0.01);
+  EXPECT_TRUE(ExistsFile(JoinPaths(out, "stereo", "evaluation", "v0.png.error.png")));
+  const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
+  EXPECT_EQ(json["views"].size(), 2u);
+  EXPECT_EQ(json["overall"]["num_hair_pixels"].get<long>(), result.overall.num_hair_pixels);
+  EXPECT_NE(result.Table().find("overall"), std::string::npos);
+}
+
+TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
+  const Scene scene = MakeScene("noise");
+  const std::string out = JoinPaths(scene.dir, "noisy");
+  ImportGroundTruthOptions import_options;
+  import_options.noise_m = 1e-3;
+  import_options.seed = 3;
+  ImportGroundTruth(scene.gt, scene.workspace, out, import_options);
+  // Knock out every other row of v0: completeness 50%.
+  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
+  FloatMap depth = ReadMat(v0);
+  for (int r = 0; r < kHeight; r += 2) {
+    for (int c = 0; c < kWidth; ++c) depth.At(r, c) = 0;
+  }
+  WriteMat(v0, depth);
+  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, FastDepthOptions());
+  EXPECT_NEAR(result.views[0].completeness, 0.5, 0.02);
+  EXPECT_DOUBLE_EQ(result.views[1].completeness, 1.0);
+  // |N(0, 1 mm)|: mean 0.80 mm, median 0.67 mm, 68% within 1 mm, 95% within 2 mm.
+  EXPECT_NEAR(result.overall.mean_abs_error_mm, 0.80, 0.06);
+  EXPECT_NEAR(result.overall.median_abs_error_mm, 0.67, 0.07);
+  EXPECT_NEAR(result.overall.within_1mm, 0.68, 0.04);
+  EXPECT_NEAR(result.overall.within_2mm, 0.95, 0.02);
+  EXPECT_GT(result.overall.accuracy_3d_median_mm, 0.4);
+
+  // A half-resolution depth map (32 x 24) of the truth: the gt is sampled at its pixels and
+  // the camera scaled, so the errors stay ~0 (the gt pixel nearest each centre is exact only
+  // up to the depth change over half a pixel on this nearly fronto-parallel plane).
+  const std::string out2 = JoinPaths(scene.dir, "half");
+  ImportGroundTruth(scene.gt, scene.workspace, out2, ImportGroundTruthOptions());
+  FloatMap half(kWidth / 2, kHeight / 2, 1, 0.0f);
+  Eigen::Matrix3d K_half = scene.cameras.K;
+  K_half.row(0) *= 0.5;
+  K_half.row(1) *= 0.5;
+  for (int r = 0; r < kHeight / 2; ++r) {
+    for (int c = 0; c < kWidth / 2; ++c) {
+      // Exact plane depth through the half-resolution pixel centre (camera 0 = world).
+      const Eigen::Vector3d ray = BackProjectPixel(K_half, c, r, 1.0);
+      const Eigen::Vector3d X = ray * (kPlaneZ / ray.z());
+      if (std::abs(X.x()) <= kHairHalfX && std::abs(X.y()) <= kHairHalfY) half.At(r, c) = X.z();
+    }
+  }
+  WriteMat(JoinPaths(out2, "stereo", "depth_maps", "v0.png.geometric.bin"), half);
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v0.png"};
+  const DepthEvaluationResult half_result = EvaluateDepthMaps(out2, scene.gt, options);
+  EXPECT_EQ(half_result.views[0].num_hair_pixels, [&] {
+    long n = 0;
+    for (float d : half.Data()) n += d > 0;
+    return n;
+  }());
+  EXPECT_LT(half_result.overall.mean_abs_error_mm, 1e-3);
+  EXPECT_LT(half_result.overall.accuracy_3d_mean_mm, 0.0502);
+}
+
+TEST(EvaluationCommands, ImportRefusesToWriteIntoItsInputs) {
+  const Scene scene = MakeScene("refuse");
+  EXPECT_THROW(ImportGroundTruth(scene.gt, scene.workspace, JoinPaths(scene.workspace, "x"),
+                                 ImportGroundTruthOptions()),
+               Error);
+  EXPECT_THROW(ImportGroundTruth(scene.gt, scene.workspace, scene.gt, ImportGroundTruthOptions()),
+               Error);
+}
+
+TriangleMesh HairPlaneMesh(double offset_z) {
+  TriangleMesh mesh;
+  const float z = static_cast<float>(kPlaneZ + offset_z);
+  mesh.vertices = {{-0.03f, -0.02f, z}, {0.03f, -0.02f, z}, {0.03f, 0.02f, z}, {-0.03f, 0.02f, z}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  return mesh;
+}
+
+TEST(EvaluationCommands, EvaluateMesh) {
+  const Scene scene = MakeScene("mesh");
+  MeshEvaluationOptions options;
+  options.strand_spacing_m = 2e-3;
+  options.face_sample_spacing_m = 1e-3;
+
+  const std::string on_plane = JoinPaths(scene.dir, "on_plane.ply");
+  WriteMeshPly(on_plane, HairPlaneMesh(0.0));
+  const MeshEvaluationResult exact = EvaluateMesh(on_plane, scene.gt, "", options);
+  EXPECT_EQ(exact.num_faces, 2);
+  EXPECT_LT(exact.accuracy_surface.mean_mm, 0.0501);
+  EXPECT_GT(exact.accuracy_surface.count, 2000);  // 24 cm^2 at one sample per mm^2
+  EXPECT_DOUBLE_EQ(exact.completeness_2mm, 1.0);
+  EXPECT_LT(exact.completeness_distance.p90_mm, 1e-3);
+  EXPECT_TRUE(ExistsFile(on_plane + ".evaluation.json"));
+
+  // 3 mm in front of the plane: accuracy 3 mm, nothing within 2 mm, everything within 5 mm.
+  const std::string shifted = JoinPaths(scene.dir, "shifted.ply");
+  WriteMeshPly(shifted, HairPlaneMesh(-0.003));
+  const MeshEvaluationResult off = EvaluateMesh(shifted, scene.gt, scene.workspace, options);
+  EXPECT_NEAR(off.accuracy_vertices.median_mm, 3.0, 1e-3);
+  EXPECT_NEAR(off.accuracy_surface.median_mm, 3.0, 1e-3);
+  EXPECT_NEAR(off.completeness_distance.median_mm, 3.0, 1e-3);
+  EXPECT_DOUBLE_EQ(off.completeness_2mm, 0.0);
+  EXPECT_DOUBLE_EQ(off.completeness_5mm, 1.0);
+  EXPECT_TRUE(ExistsFile(JoinPaths(scene.workspace, "stereo", "evaluation",
+                                   "mesh_evaluation.json")));
+}
+
+}  // namespace
+}  // namespace hairmvs
