@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <fstream>
+#include <random>
 #include <set>
 #include <sstream>
 
@@ -186,6 +188,39 @@ TEST(Reconstruction, HugeCountIsTruncationNotAllocation) {
   Reconstruction r;
   ExpectErrorMentions([&] { ReadPoints3DBinary(in, "points3D.bin", &r); },
                       {"points3D.bin", "truncated"});
+}
+
+TEST(Reconstruction, CorruptedBinaryEitherReadsOrThrows) {
+  // Random byte changes (fixed seed): every outcome is a model or a hairmvs::Error, never a
+  // crash or a runaway allocation.
+  const Reconstruction model = MakePlaneModel();
+  std::stringstream cameras, images, points;
+  WriteCamerasBinary(model, cameras);
+  WriteImagesBinary(model, images);
+  WritePoints3DBinary(model, points);
+  using Reader = void (*)(std::istream&, const std::string&, Reconstruction*);
+  const std::vector<std::pair<std::string, Reader>> cases = {
+      {cameras.str(), ReadCamerasBinary},
+      {images.str(), ReadImagesBinary},
+      {points.str(), ReadPoints3DBinary}};
+  std::mt19937 rng(11);
+  int num_errors = 0;
+  for (const auto& [bytes, reader] : cases) {
+    for (int trial = 0; trial < 200; ++trial) {
+      std::string corrupted = bytes;
+      std::uniform_int_distribution<size_t> pos(0, corrupted.size() - 1);
+      for (int k = 0; k < 3; ++k) corrupted[pos(rng)] = static_cast<char>(rng() & 0xff);
+      std::istringstream in(corrupted);
+      Reconstruction r;
+      try {
+        reader(in, "fuzz.bin", &r);
+      } catch (const Error& e) {
+        ++num_errors;
+        EXPECT_NE(std::string(e.what()).find("fuzz.bin"), std::string::npos) << e.what();
+      }
+    }
+  }
+  EXPECT_GT(num_errors, 0);
 }
 
 TEST(Reconstruction, UnknownModelIdInBinary) {
