@@ -21,7 +21,8 @@
 //                  centre tap's weight is halved, as it is loaded twice).
 //   mask           width x height at row stride out_stride; > 0 = valid.
 //   out            2 planes (Re O, Im O) of out_stride x height floats each.
-//   num_blocks, num_orientations, width, height, out_stride, gamma.
+//   num_blocks, num_orientations, width, height, out_stride, gamma,
+//   min_positive_ratio   O = 0 unless max signed response > min_positive_ratio * max |response|.
 // Theta_k = k pi / num_orientations (from +x towards +y); angles k >= num_orientations of the
 // last block carry zero weights and are never chosen.
 
@@ -39,7 +40,7 @@ __kernel void orientation_field(__global const float* restrict padded, int padde
                                 __global const float* restrict mask,
                                 __global float* restrict out, int num_blocks,
                                 int num_orientations, int width, int height, int out_stride,
-                                float gamma) {
+                                float gamma, float min_positive_ratio) {
   const int x0 = get_global_id(0) * VEC;
   const int y = get_global_id(1);
   if (y >= height || x0 >= out_stride) return;
@@ -74,13 +75,15 @@ __kernel void orientation_field(__global const float* restrict padded, int padde
     }
   }
 
-  // O = F exp(2 i Theta), F = max|response|^gamma, only for bright strands (max signed > 0).
+  // O = F exp(2 i Theta), F = max|response|^gamma, only for bright strands (Eq. 1: max signed
+  // response > 0, with a relative tolerance for responses that are zero up to rounding).
   const floatV confidence = pow(fmax(best_abs, (floatV)(0.0f)), (floatV)(gamma));
   const floatV two_theta = best_index * (2.0f * M_PI_F / (float)num_orientations);
   floatV cos_two_theta;
   const floatV sin_two_theta = sincos(two_theta, &cos_two_theta);
   const floatV m = vloadV(0, mask + y * out_stride + x0);
-  const intV valid = isgreater(max_signed, (floatV)(0.0f)) & isgreater(m, (floatV)(0.0f));
+  const intV valid =
+      isgreater(max_signed, min_positive_ratio * best_abs) & isgreater(m, (floatV)(0.0f));
   const floatV re = select((floatV)(0.0f), confidence * cos_two_theta, valid);
   const floatV im = select((floatV)(0.0f), confidence * sin_two_theta, valid);
   vstoreV(re, 0, out + y * out_stride + x0);

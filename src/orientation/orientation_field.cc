@@ -61,6 +61,7 @@ FloatMap DownsampleMask(const FloatMap& mask) {
 
 FloatMap ComputeOrientationLevelReference(const FloatMap& gray, const FloatMap& mask,
                                           const OrientationFilterBank& bank, double gamma,
+                                          double min_positive_response_ratio,
                                           std::vector<FloatMap>* responses) {
   CheckInputs(gray, mask);
   const int w = gray.Width(), h = gray.Height(), n = bank.NumOrientations();
@@ -85,7 +86,8 @@ FloatMap ComputeOrientationLevelReference(const FloatMap& gray, const FloatMap& 
         }
         max_signed = std::max(max_signed, response);
       }
-      const bool valid = max_signed > 0 && (mask.Empty() || mask.At(row, col) > 0);
+      const bool valid = max_signed > min_positive_response_ratio * best_abs &&
+                         (mask.Empty() || mask.At(row, col) > 0);
       if (!valid) continue;
       const double confidence = std::pow(best_abs, gamma);
       const double two_theta = 2.0 * bank.ThetaRad(best_k);
@@ -107,7 +109,8 @@ std::vector<FloatMap> ComputeOrientationFieldReference(const FloatMap& gray, con
       level_mask = DownsampleMask(level_mask);
     }
     levels.push_back(
-        ComputeOrientationLevelReference(level_gray, level_mask, bank, options.confidence_gamma));
+        ComputeOrientationLevelReference(level_gray, level_mask, bank, options.confidence_gamma,
+                                         options.min_positive_response_ratio));
   }
   return levels;
 }
@@ -250,6 +253,7 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     k.setArg(arg++, h);
     k.setArg(arg++, out_stride);
     k.setArg(arg++, static_cast<float>(options_.confidence_gamma));
+    k.setArg(arg++, static_cast<float>(options_.min_positive_response_ratio));
     const cl::NDRange local(config_.local_size_x, config_.local_size_y);
     const cl::NDRange global(RoundUp(out_stride / vec, config_.local_size_x),
                              RoundUp(h, config_.local_size_y));
