@@ -61,7 +61,8 @@ void RunSolver(benchmark::State& state, const MrfSolverOptions& options) {
   const int height = state.range(1);
   const int num_labels = state.range(2);
   const MrfProblem& problem = Problem(width, height, num_labels);
-  OpenCLContext* context = UsesOpenCL(options.solver) ? Context() : nullptr;
+  OpenCLContext* context =
+      UsesOpenCL(options.solver) || options.graph_cuts_init_semi_global ? Context() : nullptr;
   if (context != nullptr) SolveMrf(problem, options, context);  // builds the programs
   MrfResult result;
   for (auto _ : state) {
@@ -76,6 +77,13 @@ void RunSolver(benchmark::State& state, const MrfSolverOptions& options) {
 
 void BM_GraphCuts(benchmark::State& state) { RunSolver(state, GraphCutOptions()); }
 
+// Graph cuts started from semi-global matching + ICM (OpenCL, 8 directions).
+void BM_GraphCutsFromSemiGlobal(benchmark::State& state) {
+  MrfSolverOptions options = GraphCutOptions();
+  options.graph_cuts_init_semi_global = true;
+  RunSolver(state, options);
+}
+
 void BM_SemiGlobalOpenCL(benchmark::State& state) {
   MrfSolverOptions options;
   options.solver = MrfSolverType::kSemiGlobal;
@@ -88,6 +96,14 @@ void BM_SemiGlobalCpu(benchmark::State& state) {
   MrfSolverOptions options;
   options.solver = MrfSolverType::kSemiGlobalCpu;
   options.num_directions = state.range(3);
+  options.icm_polish_iterations = state.range(4);
+  RunSolver(state, options);
+}
+
+void BM_BeliefPropagationOpenCL(benchmark::State& state) {
+  MrfSolverOptions options;
+  options.solver = MrfSolverType::kBeliefPropagation;
+  options.bp_iterations = state.range(3);
   options.icm_polish_iterations = state.range(4);
   RunSolver(state, options);
 }
@@ -124,9 +140,14 @@ void SemiGlobalArgs(benchmark::internal::Benchmark* b) {
 }
 
 BENCHMARK(BM_GraphCuts)->Apply(Sizes);
+BENCHMARK(BM_GraphCutsFromSemiGlobal)->Apply(Sizes);
 BENCHMARK(BM_SemiGlobalOpenCL)->Apply(SemiGlobalArgs);
 BENCHMARK(BM_SemiGlobalCpu)
     ->Args({256, 256, 16, 8, 10})->Args({1024, 1024, 16, 8, 10})->Args({1024, 1024, 32, 8, 10})
+    ->Iterations(1)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime();
+BENCHMARK(BM_BeliefPropagationOpenCL)
+    ->Args({256, 256, 16, 30, 0})->Args({256, 256, 16, 30, 10})
+    ->Args({1024, 1024, 16, 30, 10})->Args({1024, 1024, 32, 30, 10})
     ->Iterations(1)->Unit(benchmark::kSecond)->MeasureProcessCPUTime()->UseRealTime();
 BENCHMARK(BM_Icm)->Apply(Sizes);
 BENCHMARK(BM_WinnerTakeAll)->Apply(Sizes);

@@ -12,52 +12,7 @@
 
 #pragma OPENCL FP_CONTRACT OFF
 
-#ifndef NUM_LABELS
-#error "NUM_LABELS must be defined"
-#endif
-
-// m[b] = min_a prev[a] + weight * min((a * step - (delta + b * step))^2, truncation) with the
-// lower envelope of parabolas (Felzenszwalb and Huttenlocher 2004), O(L). The twin of
-// SemiGlobalPathMin in src/mrf/semi_global.cc (same arithmetic order).
-inline void sgm_path_min(const float* prev, float prev_min, float step, float delta, float weight,
-                         float truncation, float* m) {
-  if (!(weight > 0.0f)) {
-    for (int b = 0; b < NUM_LABELS; ++b) m[b] = prev_min;
-    return;
-  }
-  int v[NUM_LABELS];
-  float z[NUM_LABELS + 1];
-  int k = 0;
-  v[0] = 0;
-  z[0] = -INFINITY;
-  z[1] = INFINITY;
-  for (int a = 1; a < NUM_LABELS; ++a) {
-    const float xa = (float)a * step;
-    const float ha = prev[a] + weight * (xa * xa);
-    for (;;) {
-      const float xc = (float)v[k] * step;
-      const float hc = prev[v[k]] + weight * (xc * xc);
-      const float s = (ha - hc) / (2.0f * weight * (xa - xc));
-      if (k > 0 && s <= z[k]) {
-        --k;
-        continue;
-      }
-      ++k;
-      v[k] = a;
-      z[k] = s;
-      z[k + 1] = INFINITY;
-      break;
-    }
-  }
-  const float truncated = prev_min + weight * truncation;
-  k = 0;
-  for (int b = 0; b < NUM_LABELS; ++b) {
-    const float y = delta + (float)b * step;
-    while (z[k + 1] < y) ++k;
-    const float d = y - (float)v[k] * step;
-    m[b] = fmin(prev[v[k]] + weight * (d * d), truncated);
-  }
-}
+#include "mrf_path_min.clh"
 
 __kernel void sgm_path(__global const float* cost, __global const float* offset, float step,
                        __global const float* weight, float truncation, int width, int height,
@@ -102,7 +57,7 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
     p = row * width + col;
     const float w = weight[upper_is_prev ? q : p];
     const float cur_offset = offset[p];
-    sgm_path_min(prev, prev_min, step, cur_offset - prev_offset, w, truncation, m);
+    mrf_path_min(prev, prev_min, step, cur_offset - prev_offset, w, truncation, m);
     float cur_min = INFINITY;
     for (int b = 0; b < NUM_LABELS; ++b) {
       cur[b] = cost[b * n + p] + (m[b] - prev_min);

@@ -8,6 +8,7 @@
 
 #include "src/core/logging.h"
 #include "src/core/timer.h"
+#include "src/mrf/belief_propagation.h"
 #include "src/mrf/graph_cuts.h"
 #include "src/mrf/semi_global.h"
 
@@ -162,6 +163,8 @@ std::string ToString(MrfSolverType type) {
     case MrfSolverType::kGraphCuts: return "graph_cuts";
     case MrfSolverType::kSemiGlobal: return "semi_global";
     case MrfSolverType::kSemiGlobalCpu: return "semi_global_cpu";
+    case MrfSolverType::kBeliefPropagation: return "belief_propagation";
+    case MrfSolverType::kBeliefPropagationCpu: return "belief_propagation_cpu";
     case MrfSolverType::kIcm: return "icm";
     case MrfSolverType::kWinnerTakeAll: return "winner_take_all";
   }
@@ -170,7 +173,8 @@ std::string ToString(MrfSolverType type) {
 
 bool FromString(const std::string& text, MrfSolverType* type) {
   for (MrfSolverType t : {MrfSolverType::kGraphCuts, MrfSolverType::kSemiGlobal,
-                          MrfSolverType::kSemiGlobalCpu, MrfSolverType::kIcm,
+                          MrfSolverType::kSemiGlobalCpu, MrfSolverType::kBeliefPropagation,
+                          MrfSolverType::kBeliefPropagationCpu, MrfSolverType::kIcm,
                           MrfSolverType::kWinnerTakeAll}) {
     if (text == ToString(t)) {
       *type = t;
@@ -180,7 +184,9 @@ bool FromString(const std::string& text, MrfSolverType* type) {
   return false;
 }
 
-bool UsesOpenCL(MrfSolverType type) { return type == MrfSolverType::kSemiGlobal; }
+bool UsesOpenCL(MrfSolverType type) {
+  return type == MrfSolverType::kSemiGlobal || type == MrfSolverType::kBeliefPropagation;
+}
 
 bool MrfSolverOptions::Check(std::string* error) const {
   auto fail = [error](const std::string& message) {
@@ -190,6 +196,7 @@ bool MrfSolverOptions::Check(std::string* error) const {
   if (max_cycles < 1) return fail("Mrf.max_cycles must be >= 1");
   if (!(min_relative_decrease >= 0)) return fail("Mrf.min_relative_decrease must be >= 0");
   if (num_directions != 4 && num_directions != 8) return fail("Mrf.num_directions must be 4 or 8");
+  if (bp_iterations < 1) return fail("Mrf.bp_iterations must be >= 1");
   if (icm_polish_iterations < 0) return fail("Mrf.icm_polish_iterations must be >= 0");
   return true;
 }
@@ -212,7 +219,18 @@ MrfResult SolveMrf(const MrfProblem& problem, const MrfSolverOptions& options,
   MrfResult result;
   switch (options.solver) {
     case MrfSolverType::kGraphCuts:
-      result.labels = WinnerTakeAll(problem);
+      if (options.graph_cuts_init_semi_global) {
+        constexpr int kInitIcmSweeps = 10;
+        if (context != nullptr) {
+          result.labels =
+              SolveSemiGlobalOpenCL(problem, options.num_directions, kInitIcmSweeps, context);
+        } else {
+          result.labels = SolveSemiGlobalCpu(problem, options.num_directions);
+          PolishWithIcm(problem, kInitIcmSweeps, &result.labels);
+        }
+      } else {
+        result.labels = WinnerTakeAll(problem);
+      }
       result.cycles = SolveAlphaExpansion(problem, options.max_cycles,
                                           options.min_relative_decrease, &result.labels);
       break;
@@ -226,6 +244,15 @@ MrfResult SolveMrf(const MrfProblem& problem, const MrfSolverOptions& options,
       result.labels = SolveSemiGlobalCpu(problem, options.num_directions);
       result.cycles = 1;
       break;
+    case MrfSolverType::kBeliefPropagation:
+      result.labels = SolveBeliefPropagationOpenCL(problem, options.bp_iterations,
+                                                   options.icm_polish_iterations, context);
+      result.cycles = options.bp_iterations;
+      break;
+    case MrfSolverType::kBeliefPropagationCpu:
+      result.labels = SolveBeliefPropagationCpu(problem, options.bp_iterations);
+      result.cycles = options.bp_iterations;
+      break;
     case MrfSolverType::kIcm:
       result.labels = WinnerTakeAll(problem);
       result.cycles = PolishWithIcm(problem, options.max_cycles, &result.labels);
@@ -234,7 +261,8 @@ MrfResult SolveMrf(const MrfProblem& problem, const MrfSolverOptions& options,
       result.labels = WinnerTakeAll(problem);
       break;
   }
-  if (options.icm_polish_iterations > 0 && options.solver != MrfSolverType::kSemiGlobal) {
+  // (The OpenCL solvers ran their polish on the device.)
+  if (options.icm_polish_iterations > 0 && !UsesOpenCL(options.solver)) {
     PolishWithIcm(problem, options.icm_polish_iterations, &result.labels);
   }
   result.energy = MrfEnergy(problem, result.labels);

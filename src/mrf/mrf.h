@@ -15,6 +15,8 @@
 //    "truncation"; see graph_cuts.cc) so that each move never increases the energy.
 //  - semi_global / semi_global_cpu: semi-global matching (Hirschmueller 2008) along 4 or 8
 //    scanline directions with the MRF's own pairwise term V_pq; OpenCL / plain CPU reference.
+//  - belief_propagation / belief_propagation_cpu: loopy min-sum belief propagation on the
+//    4-connected grid, checkerboard updates, O(L) messages; OpenCL / plain CPU reference.
 //  - icm: winner-take-all then iterated conditional modes (a baseline and a polish).
 //  - winner_take_all: per-pixel argmin of the data term only.
 
@@ -79,6 +81,8 @@ enum class MrfSolverType {
   kGraphCuts,
   kSemiGlobal,
   kSemiGlobalCpu,
+  kBeliefPropagation,
+  kBeliefPropagationCpu,
   kIcm,
   kWinnerTakeAll,
 };
@@ -96,19 +100,28 @@ struct MrfSolverOptions {
   double min_relative_decrease = 1e-4;
   // semi_global*: 4 (horizontal and vertical) or 8 (plus diagonals) scanline directions.
   int num_directions = 8;
+  // belief_propagation*: message-passing iterations (each updates both checkerboard colours).
+  int bp_iterations = 30;
   // Any solver: ICM sweeps run on its result (0 = none); never increases E.
   int icm_polish_iterations = 0;
+  // graph_cuts: start from semi-global matching + ICM (OpenCL when a context is given, else
+  // the CPU reference) instead of winner-take-all. Fewer, cheaper max-flows.
+  bool graph_cuts_init_semi_global = false;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
     v("solver", &solver,
-      "graph_cuts | semi_global | semi_global_cpu | icm | winner_take_all");
+      "graph_cuts | semi_global | semi_global_cpu | belief_propagation | "
+      "belief_propagation_cpu | icm | winner_take_all");
     v("max_cycles", &max_cycles, "alpha-expansion cycles (graph_cuts) or ICM sweeps (icm)");
     v("min_relative_decrease", &min_relative_decrease,
       "stop when a cycle lowers the energy by less than this fraction");
     v("num_directions", &num_directions, "semi-global matching scanline directions: 4 or 8");
+    v("bp_iterations", &bp_iterations, "belief propagation iterations");
     v("icm_polish_iterations", &icm_polish_iterations,
       "ICM sweeps after the solver (0 = none)");
+    v("graph_cuts_init_semi_global", &graph_cuts_init_semi_global,
+      "graph_cuts: start from semi-global matching + ICM instead of winner-take-all");
   }
   bool Check(std::string* error) const;
 };
@@ -121,8 +134,8 @@ struct MrfResult {
   std::string BriefReport() const;
 };
 
-// Minimises E with the chosen solver. context: needed by the OpenCL solvers (semi_global;
-// hairmvs::Error if null), ignored by the others. Throws hairmvs::Error
+// Minimises E with the chosen solver. context: needed by the OpenCL solvers (semi_global,
+// belief_propagation; hairmvs::Error if null), ignored by the others. Throws hairmvs::Error
 // on an invalid problem or options.
 MrfResult SolveMrf(const MrfProblem& problem, const MrfSolverOptions& options,
                    OpenCLContext* context);

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "src/core/logging.h"
+#include "src/mrf/icm_opencl.h"
 #include "src/opencl/opencl_context.h"
 
 namespace hairmvs {
@@ -32,7 +33,7 @@ const std::vector<float>& DirectionWeights(const SemiGlobalEdgeWeights& weights,
 
 void SemiGlobalPathMin(const float* prev, float prev_min, int num_labels, float step, float delta,
                        float weight, float truncation, int* v, float* z, float* m) {
-  // The same float arithmetic, in the same order, as sgm_path_min in kernels/mrf_sgm.cl.
+  // The same float arithmetic, in the same order, as mrf_path_min in kernels/mrf_path_min.clh.
   const float kInf = std::numeric_limits<float>::infinity();
   if (!(weight > 0.0f)) {
     for (int b = 0; b < num_labels; ++b) m[b] = prev_min;
@@ -260,33 +261,9 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
                              cl::NDRange(rounded(static_cast<int>(n))), cl::NDRange(kLocalSize));
 
   if (icm_iterations > 0) {
-    // Checkerboard ICM on the labels still on the device (kernels/mrf_icm.cl).
-    cl::Program& icm_program =
-        context->Program({"mrf_icm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
-    cl::Kernel icm_kernel(icm_program, "icm_colour");
-    cl::Buffer changed_buffer(ctx, CL_MEM_READ_WRITE, sizeof(int));
-    icm_kernel.setArg(0, cost_buffer);
-    icm_kernel.setArg(1, offset_buffer);
-    icm_kernel.setArg(2, problem.label_step);
-    icm_kernel.setArg(3, weight_buffers[0]);  // direction (1, 0): weights.right
-    icm_kernel.setArg(4, weight_buffers[2]);  // direction (0, 1): weights.down
-    icm_kernel.setArg(5, FiniteTruncation(problem));
-    icm_kernel.setArg(6, width);
-    icm_kernel.setArg(7, height);
-    icm_kernel.setArg(9, label_buffer);
-    icm_kernel.setArg(10, changed_buffer);
-    for (int sweep = 0; sweep < icm_iterations; ++sweep) {
-      queue.enqueueFillBuffer(changed_buffer, 0, 0, sizeof(int));
-      for (int colour = 0; colour < 2; ++colour) {
-        icm_kernel.setArg(8, colour);
-        queue.enqueueNDRangeKernel(icm_kernel, cl::NullRange,
-                                   cl::NDRange(rounded(static_cast<int>(n))),
-                                   cl::NDRange(kLocalSize));
-      }
-      int changed = 0;
-      queue.enqueueReadBuffer(changed_buffer, CL_TRUE, 0, sizeof(int), &changed);
-      if (!changed) break;
-    }
+    // weight_buffers[0], [2]: directions (1, 0) and (0, 1), i.e. weights.right and .down.
+    RunIcmOpenCL(context, cost_buffer, offset_buffer, weight_buffers[0], weight_buffers[2],
+                 problem, icm_iterations, label_buffer);
   }
   std::vector<int> labels(n);
   queue.enqueueReadBuffer(label_buffer, CL_TRUE, 0, n * sizeof(int), labels.data());

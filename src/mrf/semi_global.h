@@ -30,7 +30,7 @@ SemiGlobalEdgeWeights ComputeSemiGlobalEdgeWeights(const MrfProblem& problem);
 
 // m[b] = min_a prev[a] + weight * min((a * step - (delta + b * step))^2, truncation), for
 // b = 0..num_labels-1, with the lower envelope of parabolas (O(L)); prev_min = min_a prev[a].
-// The CPU twin of sgm_path_min in kernels/mrf_sgm.cl. v, z: scratch of num_labels and
+// The CPU twin of mrf_path_min in kernels/mrf_path_min.clh. v, z: scratch of num_labels and
 // num_labels + 1 entries.
 void SemiGlobalPathMin(const float* prev, float prev_min, int num_labels, float step, float delta,
                        float weight, float truncation, int* v, float* z, float* m);
