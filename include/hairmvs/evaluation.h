@@ -124,9 +124,9 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
 struct MeshEvaluationOptions {
   // Accuracy also from points sampled on the faces, about this far apart (0 = vertices only).
   double face_sample_spacing_m = 5e-4;
-  // The mesh surface is sampled this densely for completeness (nearest-sample distance; a
-  // sample spacing s overestimates a distance by at most ~s/2, and less for distances >> s).
-  double surface_sample_spacing_m = 2e-4;
+  // Completeness distances are exact point-to-triangle distances; the faces are sampled this
+  // densely for the KD-tree that finds the candidate faces (speed and memory only).
+  double surface_sample_spacing_m = 5e-4;
   // True visible hair surface: hair pixels of every view, at most this many (random).
   int max_ground_truth_points = 300000;
   int seed = 0;
@@ -140,7 +140,7 @@ struct MeshEvaluationOptions {
     v("face_sample_spacing_m", &face_sample_spacing_m,
       "accuracy also from face samples this far apart (0 = vertices only)");
     v("surface_sample_spacing_m", &surface_sample_spacing_m,
-      "mesh surface sampling for completeness distances (m)");
+      "face sampling of the KD-tree for exact point-to-mesh distances (m; speed only)");
     v("max_ground_truth_points", &max_ground_truth_points,
       "subsample of the visible true hair surface");
     v("seed", &seed, "random seed of the subsampling");
