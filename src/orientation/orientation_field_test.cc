@@ -104,13 +104,17 @@ std::shared_ptr<OpenCLContext> OrientationFieldTest::context_;
 // Compares one level of the kernel with the CPU reference: where the reference confidence is
 // above a small threshold, the confidence agrees to 1e-3 (relative) and the angle to 1 degree,
 // unless the two angles are a tie in the reference's responses (|R| within 1e-5 relative).
-void ExpectMatchesReference(const FloatMap& gray, const FloatMap& mask, const FloatMap& kernel,
+struct Reference {
+  FloatMap gray, mask, field;
+  std::vector<FloatMap> responses;  // per filter
+};
+
+void ExpectMatchesReference(const Reference& ref, const FloatMap& kernel,
                             const OrientationFieldOptions& options, const std::string& what) {
-  const OrientationFilterBank bank(options);
-  std::vector<FloatMap> responses;
-  const FloatMap reference =
-      ComputeOrientationLevelReference(gray, mask, bank, options.confidence_gamma,
-                                       options.min_positive_response_ratio, &responses);
+  const FloatMap& gray = ref.gray;
+  const FloatMap& mask = ref.mask;
+  const FloatMap& reference = ref.field;
+  const std::vector<FloatMap>& responses = ref.responses;
   ASSERT_EQ(kernel.Width(), reference.Width());
   ASSERT_EQ(kernel.Height(), reference.Height());
   ASSERT_EQ(kernel.Channels(), 2);
@@ -154,18 +158,25 @@ TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
     }
   }
   const OrientationFieldOptions options;
+  const OrientationFilterBank bank(options);
+  std::vector<Reference> references(3);
+  for (int l = 0; l < 3; ++l) {
+    Reference& ref = references[l];
+    ref.gray = l == 0 ? gray : DownsampleGray(references[l - 1].gray);
+    ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
+    ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank, options.confidence_gamma,
+                                                 options.min_positive_response_ratio,
+                                                 &ref.responses);
+  }
+  // The default configuration, and one with 8-pixel vectors, a block size that leaves a
+  // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
   for (const OrientationKernelConfig& config :
        {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
     OrientationFieldComputer computer(context_, options, config);
     const std::vector<FloatMap> levels = computer.Compute(gray, mask);
     ASSERT_EQ(levels.size(), 3u);
-    FloatMap level_gray = gray, level_mask = mask;
     for (int l = 0; l < 3; ++l) {
-      if (l > 0) {
-        level_gray = DownsampleGray(level_gray);
-        level_mask = DownsampleMask(level_mask);
-      }
-      ExpectMatchesReference(level_gray, level_mask, levels[l], options,
+      ExpectMatchesReference(references[l], levels[l], options,
                              "level " + std::to_string(l) + " vec " +
                                  std::to_string(config.vector_width) + " block " +
                                  std::to_string(config.block_size));
