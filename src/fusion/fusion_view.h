@@ -1,0 +1,78 @@
+#pragma once
+// The in-memory inputs and outputs of template fusion, free of any file format, so that tests
+// can hand the pipeline synthetic depth maps directly.
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "src/core/float_map.h"
+
+namespace hairmvs {
+
+// One depth map with its calibrated pinhole camera (cam_from_world: X_cam = R X + t).
+struct FusionView {
+  std::string name;
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  FloatMap depth;   // z-depth on the pixel grid, 0 = invalid
+  FloatMap normal;  // 3 channels, camera-frame unit normals facing the camera; empty = from depth
+  FloatMap rgb;     // 3 channels (R, G, B) in [0, 1]; empty = grey
+
+  Eigen::Vector3d Center() const { return -R.transpose() * t; }
+  // Projects a world point into the pixel grid (SfM convention: pixel (col,row) covers
+  // [col, col+1) x [row, row+1)). Returns false behind the camera or outside the map.
+  bool Project(const Eigen::Vector3d& world, int* col, int* row, double* z) const {
+    const Eigen::Vector3d cam = R * world + t;
+    if (cam.z() <= 0) return false;
+    const Eigen::Vector3d uv = K * cam;
+    const double u = uv.x() / uv.z(), v = uv.y() / uv.z();
+    if (!(u >= 0 && v >= 0 && u < depth.Width() && v < depth.Height())) return false;
+    *col = static_cast<int>(u);
+    *row = static_cast<int>(v);
+    *z = cam.z();
+    return true;
+  }
+  // The point of this map's surface on the line of sight through `world` (the depth of the
+  // pixel it projects to, along its own ray): how the map "sees" that point.
+  Eigen::Vector3d SurfaceOnRay(const Eigen::Vector3d& world, double z, float map_depth) const {
+    const Eigen::Vector3d c = Center();
+    return c + (world - c) * (map_depth / z);
+  }
+  Eigen::Vector3d WorldNormalAt(int row, int col) const {
+    const Eigen::Vector3d n_cam(normal.At(row, col, 0), normal.At(row, col, 1),
+                                normal.At(row, col, 2));
+    return R.transpose() * n_cam;
+  }
+};
+
+// A triangle mesh in double precision while it is being shaped.
+struct FusionMesh {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> faces;
+  std::vector<Eigen::Vector3d> normals;  // per vertex, area-weighted, unit
+  std::vector<std::array<uint8_t, 3>> colors;
+
+  void ComputeVertexNormals();
+  double MeanEdgeLength() const;
+  int NumEdges() const;
+  int EulerCharacteristic() const;  // V - E + F
+  // Face indices per connected component (faces sharing a vertex are connected).
+  std::vector<int> FaceComponents(int* num_components) const;
+  // Keeps the faces with keep[f], then drops unreferenced vertices.
+  void KeepFaces(const std::vector<bool>& keep);
+};
+
+// fused.ply's points before they are written.
+struct FusionPoints {
+  std::vector<Eigen::Vector3f> xyz;
+  std::vector<Eigen::Vector3f> normal;
+  std::vector<std::array<uint8_t, 3>> rgb;
+  std::vector<std::vector<uint32_t>> visible_views;  // indices into the views, ascending
+  size_t Size() const { return xyz.size(); }
+};
+
+}  // namespace hairmvs

@@ -1,0 +1,137 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "src/fusion/fusion_points.h"
+#include "src/fusion/fusion_test_scenes.h"
+#include "src/fusion/template_fusion_core.h"
+
+namespace hairmvs {
+namespace {
+
+struct SurfaceError {
+  double mean = 0, max = 0, rms = 0;
+};
+
+SurfaceError ErrorToSurface(const testing::Sdf& sdf, const FusionMesh& mesh) {
+  SurfaceError e;
+  for (const Eigen::Vector3d& v : mesh.vertices) {
+    const double d = testing::SurfaceDistance(sdf, v);
+    e.mean += d;
+    e.rms += d * d;
+    e.max = std::max(e.max, d);
+  }
+  e.mean /= mesh.vertices.size();
+  e.rms = std::sqrt(e.rms / mesh.vertices.size());
+  return e;
+}
+
+int NumComponents(const FusionMesh& mesh) {
+  int n = 0;
+  mesh.FaceComponents(&n);
+  return n;
+}
+
+TemplateFusionOptions TestOptions() {
+  TemplateFusionOptions options;
+  options.point_stride_px = 1;  // tiny maps: keep every pixel
+  options.num_threads = 1;      // the tests run beside each other
+  return options;
+}
+
+TEST(TemplateFusion, OptionsCheck) {
+  TemplateFusionOptions options;
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options.poisson_depth = 1;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("poisson_depth"), std::string::npos);
+  options = TemplateFusionOptions();
+  options.input_type = "fancy";
+  EXPECT_FALSE(options.Check(&error));
+}
+
+TEST(TemplateFusion, PointsAreSeenByTheViewsThatAgree) {
+  testing::SceneOptions scene;
+  const std::vector<FusionView> views = testing::RenderViews(testing::SphereSdf(1.0), scene);
+  TemplateFusionOptions options = TestOptions();
+  int num_input = 0;
+  const FusionPoints points = ExtractFusionPoints(views, options, &num_input);
+  ASSERT_GT(points.Size(), 1000u);
+  double max_error = 0;
+  size_t num_multi_view = 0;
+  for (size_t i = 0; i < points.Size(); ++i) {
+    max_error = std::max(max_error, std::abs(points.xyz[i].cast<double>().norm() - 1.0));
+    // The true normal of a sphere is radial.
+    EXPECT_GT(points.normal[i].dot(points.xyz[i].normalized()), 0.95f);
+    num_multi_view += points.visible_views[i].size() >= 3;
+  }
+  // Exact depths: points on the sphere up to the ray-marching tolerance.
+  EXPECT_LT(max_error, 1e-4);
+  // 12 views around a sphere: most points are seen by several.
+  EXPECT_GT(num_multi_view, points.Size() / 2);
+}
+
+TEST(TemplateFusion, NoisyMisalignedSphereIsOneGenusZeroSurface) {
+  testing::SceneOptions scene;
+  scene.depth_noise = 0.005;
+  scene.misalignment_rad = 0.002;
+  scene.misalignment_translation = 0.005;
+  const testing::Sdf sdf = testing::SphereSdf(1.0);
+  const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
+  StageTimings timings;
+  const FusionOutput out = FuseViews(views, TestOptions(), &timings);
+  std::cerr << timings.Table() << "\n";
+  EXPECT_EQ(NumComponents(out.final_mesh), 1);
+  EXPECT_EQ(out.final_mesh.EulerCharacteristic(), 2);  // genus 0
+  const SurfaceError coarse = ErrorToSurface(sdf, out.coarse);
+  const SurfaceError refined = ErrorToSurface(sdf, out.refined);
+  const SurfaceError final_error = ErrorToSurface(sdf, out.final_mesh);
+  std::cerr << "sphere error (mean/rms/max): coarse " << coarse.mean << "/" << coarse.rms << "/"
+            << coarse.max << ", refined " << refined.mean << "/" << refined.rms << "/"
+            << refined.max << ", final " << final_error.mean << "/" << final_error.rms << "/"
+            << final_error.max << "\n";
+  // Radius 1, depth noise 0.005, poses off by ~0.1 degree and 0.005: within 1.5% of the
+  // radius on average and 6% at worst.
+  EXPECT_LT(final_error.mean, 0.015);
+  EXPECT_LT(final_error.max, 0.06);
+}
+
+TEST(TemplateFusion, NoisyMisalignedTorusIsOneGenusOneSurface) {
+  testing::SceneOptions scene;
+  scene.depth_noise = 0.005;
+  scene.misalignment_rad = 0.002;
+  scene.misalignment_translation = 0.005;
+  const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
+  const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
+  const FusionOutput out = FuseViews(views, TestOptions(), nullptr);
+  EXPECT_EQ(NumComponents(out.final_mesh), 1);
+  EXPECT_EQ(out.final_mesh.EulerCharacteristic(), 0);  // genus 1
+  const SurfaceError final_error = ErrorToSurface(sdf, out.final_mesh);
+  std::cerr << "torus error (mean/rms/max): " << final_error.mean << "/" << final_error.rms
+            << "/" << final_error.max << "\n";
+  EXPECT_LT(final_error.mean, 0.02);
+  EXPECT_LT(final_error.max, 0.1);
+}
+
+TEST(TemplateFusion, DetailRestoresHighFrequencies) {
+  testing::SceneOptions scene;
+  scene.width = 160;
+  scene.height = 120;
+  scene.focal_px = 150;
+  scene.depth_noise = 0.002;
+  // Ripples of +-0.03 with a period of ~0.4 (about 8 octree cells at depth 6).
+  const testing::Sdf sdf = testing::RippledSphereSdf(1.0, 0.03, 16);
+  const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
+  const FusionOutput out = FuseViews(views, TestOptions(), nullptr);
+  const SurfaceError refined = ErrorToSurface(sdf, out.refined);
+  const SurfaceError final_error = ErrorToSurface(sdf, out.final_mesh);
+  std::cerr << "rippled sphere rms: refined " << refined.rms << ", after detail "
+            << final_error.rms << "\n";
+  EXPECT_GT(out.detail.num_vertices_with_detail, static_cast<int>(out.final_mesh.vertices.size() / 2));
+  EXPECT_LT(final_error.rms, 0.7 * refined.rms);
+}
+
+}  // namespace
+}  // namespace hairmvs
