@@ -118,7 +118,8 @@ void ExpectMatchesReference(const Reference& ref, const FloatMap& kernel,
   ASSERT_EQ(kernel.Width(), reference.Width());
   ASSERT_EQ(kernel.Height(), reference.Height());
   ASSERT_EQ(kernel.Channels(), 2);
-  int compared = 0, masked = 0;
+  int compared = 0, masked = 0, ties = 0;
+  double worst_relative = 0, worst_angle = 0;
   for (int row = 0; row < gray.Height(); ++row) {
     for (int col = 0; col < gray.Width(); ++col) {
       if (!mask.Empty() && mask.At(row, col) <= 0) {
@@ -132,16 +133,22 @@ void ExpectMatchesReference(const Reference& ref, const FloatMap& kernel,
       if (f_ref < 0.02) continue;
       ++compared;
       ASSERT_NEAR(f_cl, f_ref, 1e-3 * f_ref) << what << " at " << row << "," << col;
+      worst_relative = std::max(worst_relative, std::abs(f_cl - f_ref) / f_ref);
       const double diff = AngleDiffDeg(ThetaDeg(kernel, row, col), ThetaDeg(reference, row, col));
       if (diff > 1.0 + 1e-3) {
+        ++ties;
         const int k_cl = static_cast<int>(std::lround(ThetaDeg(kernel, row, col))) % 180;
         const double best = std::pow(f_ref, 1.0 / options.confidence_gamma);
         EXPECT_GE(std::abs(responses[k_cl].At(row, col)), best * (1 - 1e-5))
             << what << ": angle " << ThetaDeg(kernel, row, col) << " vs "
             << ThetaDeg(reference, row, col) << " at " << row << "," << col;
+      } else {
+        worst_angle = std::max(worst_angle, diff);
       }
     }
   }
+  std::printf("%s: %d pixels compared, confidence rel. error <= %.2e, angle error <= %.3f deg, "
+              "%d tie(s)\n", what.c_str(), compared, worst_relative, worst_angle, ties);
   EXPECT_GT(compared, static_cast<int>(gray.NumPixels() / 4)) << what;
   if (!mask.Empty()) {
     EXPECT_GT(masked, 0) << what;
