@@ -130,9 +130,9 @@ std::vector<Eigen::Vector3f> GrowStrand(const HeadModel& head, HairStyle style, 
   // Dark brown with a per-strand variation in brightness and hue (linear RGB).
   const double brightness = std::clamp(1.0 + 0.25 * rng.Normal(), 0.5, 1.6);
   const double warmth = rng.Uniform(-0.1, 0.1);
-  *albedo = Eigen::Vector3f(static_cast<float>(0.10 * brightness * (1 + warmth)),
-                            static_cast<float>(0.058 * brightness),
-                            static_cast<float>(0.034 * brightness * (1 - warmth)));
+  *albedo = Eigen::Vector3f(static_cast<float>(0.036 * brightness * (1 + warmth)),
+                            static_cast<float>(0.022 * brightness),
+                            static_cast<float>(0.015 * brightness * (1 - warmth)));
   *layer_out = static_cast<float>(layer);
   return points;
 }

@@ -26,8 +26,8 @@ struct RenderSettings {
   Eigen::Vector3d light_direction = Eigen::Vector3d(0.25, 0.35, 1.0).normalized();  // to light
   double light_intensity = 2.2;
   double ambient = 0.35;
-  double specular = 0.35;
-  double specular_exponent = 60.0;
+  double specular = 0.12;
+  double specular_exponent = 80.0;
   Eigen::Vector3d skin_albedo = Eigen::Vector3d(0.55, 0.38, 0.30);   // linear RGB
   Eigen::Vector3d background = Eigen::Vector3d(0.216, 0.216, 0.216);  // sRGB 128 grey
   int head_supersampling = 3;  // per axis

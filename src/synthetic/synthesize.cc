@@ -25,8 +25,8 @@ namespace hairmvs {
 namespace {
 
 // Spacing of the rendered tube pieces along the Catmull-Rom centrelines: the chord of a piece
-// stays within ~10 um of the spline (straight hair bends over centimetres, curls over ~4 mm).
-constexpr double kStraightDenseSpacingM = 0.0015;
+// stays within ~20 um of the spline (straight hair bends over centimetres, curls over ~4 mm).
+constexpr double kStraightDenseSpacingM = 0.002;
 constexpr double kCurlyDenseSpacingM = 0.0008;
 
 std::string Stem(const std::string& name) {
