@@ -51,6 +51,8 @@ struct OrientationKernelConfig {
   int local_size_y = 4;
 };
 
+// Not thread-safe: one computer per thread (each may share the OpenCLContext only if the
+// callers serialise, see src/opencl/opencl_context.h).
 class OrientationFieldComputer {
  public:
   OrientationFieldComputer(std::shared_ptr<OpenCLContext> context,
