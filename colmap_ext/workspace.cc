@@ -106,7 +106,7 @@ std::string Workspace::ConfidenceMapPath(const std::string& name) const {
 std::string Workspace::OrientationMapPath(const std::string& name, int level) const {
   CHECK_GE(level, 0);
   return JoinPaths(StereoPath(), "orientation_maps",
-                   name + ".level" + std::to_string(level) + ".bin");
+                   name + ".l" + std::to_string(level) + ".bin");
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -38,14 +38,14 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
   OptionParser parser(
       "orientation_fields",
       "Computes the orientation field of each image (180-filter bank, 3 levels; Luo et al. "
-      "2012, Section 2) and writes stereo/orientation_maps/<image name>.level<k>.bin (2-channel "
+      "2012, Section 2) and writes stereo/orientation_maps/<image name>.l<k>.bin (2-channel "
       "Mat: Re O, Im O), and with --write_png 1 a picture per level (hue = strand angle, "
       "brightness = confidence).");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", true);
   parser.Add("image_names", &run_options.image_names, "comma-separated names (default: all)");
   parser.Add("mask_path", &run_options.mask_path,
              "masks folder (<image name>.png, 0 = excluded; default: <workspace>/masks if any)");
-  parser.Add("write_png", &run_options.write_png, "also write <...>.level<k>.png pictures");
+  parser.Add("write_png", &run_options.write_png, "also write <...>.l<k>.png pictures");
   parser.Add("timing", &timing, "print the per-stage timing table");
   parser.AddSection("OrientationField", &options);
   parser.AddSection("OpenCL", &opencl_options);
