@@ -6,6 +6,7 @@
 #include <random>
 
 #include "src/core/logging.h"
+#include "src/core/option_parser.h"
 #include "src/mrf/graph_cuts.h"
 #include "src/mrf/mrf_synthetic.h"
 #include "src/mrf/semi_global.h"
@@ -120,6 +121,26 @@ TEST(MrfSolverOptions, NamesRoundTripAndCheck) {
   options.num_directions = 4;
   options.solver = MrfSolverType::kSemiGlobal;
   EXPECT_THROW(SolveMrf(RandomProblem(3, 3, 2, 1, 1), options, nullptr), Error);
+}
+
+TEST(MrfSolverOptions, ParseFromTheCommandLine) {
+  MrfSolverOptions options;
+  OptionParser parser("mrf", "test");
+  parser.AddSection("Mrf", &options);
+  std::vector<std::string> args = {"hairmvs", "mrf", "--Mrf.solver", "belief_propagation",
+                                   "--Mrf.bp_iterations", "7", "--Mrf.num_directions", "4"};
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  ASSERT_TRUE(parser.Parse(static_cast<int>(argv.size()), argv.data()));
+  EXPECT_EQ(options.solver, MrfSolverType::kBeliefPropagation);
+  EXPECT_EQ(options.bp_iterations, 7);
+  EXPECT_EQ(options.num_directions, 4);
+  OptionParser bad_parser("mrf", "test");
+  bad_parser.AddSection("Mrf", &options);
+  args[3] = "no_such_solver";
+  argv.clear();
+  for (auto& a : args) argv.push_back(a.data());
+  EXPECT_THROW(bad_parser.Parse(static_cast<int>(argv.size()), argv.data()), Error);
 }
 
 // Graph cuts against the exact optimum on 3x3 pixels, 3 labels, for weak and strong
