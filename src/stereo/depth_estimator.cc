@@ -218,7 +218,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         }
       }
       const float chosen = coarse_volume[static_cast<size_t>(l) * coarse_pixels + p];
-      coarse_confidence.Data()[p] = std::isfinite(other) ? other - chosen : 0.0f;
+      // Clamped at 0: where the MRF chose a label that is not the data term's best, the
+      // data term gives no margin for it.
+      coarse_confidence.Data()[p] = std::isfinite(other) ? std::max(other - chosen, 0.0f) : 0.0f;
     }
   }
   coarse_volume.clear();
