@@ -20,6 +20,7 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
+#include "src/evaluation/depth_evaluation.h"
 #include "src/evaluation/evaluation_util.h"
 #include "src/evaluation/ground_truth.h"
 
@@ -124,6 +125,21 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const DepthEvaluationOptions& options) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
+  Timer timer;
+  const StrandDistance strand_distance(strands, options.strand_spacing_m);
+  LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
+            << strand_distance.NumSamples() << " centreline samples (" << std::fixed
+            << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
+  return EvaluateDepthMaps(workspace_path, ground_truth_path, options, strand_distance);
+}
+
+DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
+                                        const std::string& ground_truth_path,
+                                        const DepthEvaluationOptions& options,
+                                        const StrandDistance& strand_distance) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
   const Workspace ws = Workspace::Read(workspace_path);
   std::vector<std::string> names = options.image_names;
   if (names.empty()) {
@@ -136,12 +152,6 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   const std::string output_path = options.output_path.empty()
                                       ? JoinPaths(ws.StereoPath(), "evaluation")
                                       : options.output_path;
-  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
-  Timer timer;
-  const StrandDistance strand_distance(strands, options.strand_spacing_m);
-  LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
-            << strand_distance.NumSamples() << " centreline samples (" << std::fixed
-            << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
 
   DepthEvaluationResult result;
   DepthSamples pooled;
