@@ -37,6 +37,7 @@ TemplateFusionOptions TestOptions() {
   TemplateFusionOptions options;
   options.point_stride_px = 1;  // tiny maps: keep every pixel
   options.num_threads = 1;      // the tests run beside each other
+  options.max_fit_vertices = 3000;  // a few seconds per test
   return options;
 }
 
@@ -117,19 +118,24 @@ TEST(TemplateFusion, NoisyMisalignedTorusIsOneGenusOneSurface) {
 
 TEST(TemplateFusion, DetailRestoresHighFrequencies) {
   testing::SceneOptions scene;
-  scene.width = 160;
-  scene.height = 120;
-  scene.focal_px = 150;
-  scene.depth_noise = 0.002;
-  // Ripples of +-0.03 with a period of ~0.4 (about 8 octree cells at depth 6).
-  const testing::Sdf sdf = testing::RippledSphereSdf(1.0, 0.03, 16);
+  scene.width = 128;
+  scene.height = 96;
+  scene.focal_px = 120;  // pixel footprint ~0.033 at the sphere
+  scene.depth_noise = 0.001;
+  // Ripples of +-0.02 with a period of ~0.2: finer than a coarse template at octree depth 5
+  // (cell ~0.07) and its deformation graph can hold, coarser than the depth maps' pixels.
+  const testing::Sdf sdf = testing::RippledSphereSdf(1.0, 0.02, 30);
   const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
-  const FusionOutput out = FuseViews(views, TestOptions(), nullptr);
+  TemplateFusionOptions options = TestOptions();
+  options.poisson_depth = 5;
+  options.target_edge_length_px = 1.5;  // vertices dense enough to carry the ripples
+  const FusionOutput out = FuseViews(views, options, nullptr);
   const SurfaceError refined = ErrorToSurface(sdf, out.refined);
   const SurfaceError final_error = ErrorToSurface(sdf, out.final_mesh);
   std::cerr << "rippled sphere rms: refined " << refined.rms << ", after detail "
-            << final_error.rms << "\n";
-  EXPECT_GT(out.detail.num_vertices_with_detail, static_cast<int>(out.final_mesh.vertices.size() / 2));
+            << final_error.rms << " (" << out.final_mesh.vertices.size() << " vertices)\n";
+  EXPECT_GT(out.detail.num_vertices_with_detail,
+            static_cast<int>(out.final_mesh.vertices.size() / 2));
   EXPECT_LT(final_error.rms, 0.7 * refined.rms);
 }
 

@@ -1,0 +1,170 @@
+// template_fusion end to end: a COLMAP workspace with synthetic depth and normal maps of a
+// torus is written to disk, RunTemplateFusion writes fused.ply(.vis) and meshed-hair.ply,
+// which read back consistently, and `colmap poisson_mesher` reads our fused.ply.
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/ply.h"
+#include "colmap_ext/reconstruction.h"
+#include "hairmvs/template_fusion.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/fusion/fusion_test_scenes.h"
+
+namespace hairmvs {
+namespace {
+
+std::string MakeTempDir(const std::string& name) {
+  const std::string dir = JoinPaths(std::filesystem::temp_directory_path().string(),
+                                    "hairmvs_fusion_" + name + "_" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  CreateDirs(dir);
+  return dir;
+}
+
+// Writes views as a COLMAP dense workspace; image ids are assigned in reverse so that the
+// image_idx order (file order, ascending ids as we write) differs from the views' order.
+void WriteWorkspace(const std::vector<FusionView>& views, const std::string& dir) {
+  Reconstruction model;
+  Camera camera;
+  camera.camera_id = 1;
+  camera.model_id = 1;  // PINHOLE
+  camera.width = views[0].depth.Width();
+  camera.height = views[0].depth.Height();
+  camera.params = {views[0].K(0, 0), views[0].K(1, 1), views[0].K(0, 2), views[0].K(1, 2)};
+  model.cameras[1] = camera;
+  for (size_t i = 0; i < views.size(); ++i) {
+    Image image;
+    image.image_id = static_cast<uint32_t>(views.size() - i);
+    image.camera_id = 1;
+    image.name = views[i].name;
+    image.cam_from_world_rotation = Eigen::Quaterniond(views[i].R);
+    image.cam_from_world_translation = views[i].t;
+    model.images[image.image_id] = image;
+    cv::Mat bgr(views[i].depth.Height(), views[i].depth.Width(), CV_8UC3);
+    for (int r = 0; r < bgr.rows; ++r) {
+      for (int c = 0; c < bgr.cols; ++c) {
+        const uint8_t v = static_cast<uint8_t>(255 * views[i].rgb.At(r, c, 0));
+        bgr.at<cv::Vec3b>(r, c) = cv::Vec3b(v, v, v);
+      }
+    }
+    CreateDirs(JoinPaths(dir, "images"));
+    ASSERT_TRUE(cv::imwrite(JoinPaths(dir, "images", views[i].name), bgr));
+    WriteMat(JoinPaths(dir, "stereo", "depth_maps", views[i].name + ".geometric.bin"),
+             views[i].depth);
+    WriteMat(JoinPaths(dir, "stereo", "normal_maps", views[i].name + ".geometric.bin"),
+             views[i].normal);
+  }
+  model.SortImageOrder();
+  CreateDirs(JoinPaths(dir, "sparse"));
+  WriteReconstruction(model, JoinPaths(dir, "sparse"), ModelFormat::kBinary);
+}
+
+TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
+  const std::string dir = MakeTempDir("torus");
+  testing::SceneOptions scene;
+  scene.width = 64;
+  scene.height = 48;
+  scene.focal_px = 60;
+  scene.distance = 3.5;
+  scene.depth_noise = 0.003;
+  const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
+  const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
+  WriteWorkspace(views, dir);
+
+  TemplateFusionOptions options;
+  options.point_stride_px = 1;
+  options.num_threads = 1;
+  options.write_intermediate = true;
+  StageTimings timings;
+  const TemplateFusionResult result = RunTemplateFusion(dir, options, &timings);
+  std::cerr << result.BriefReport() << "\n" << timings.Table() << "\n";
+  EXPECT_EQ(result.num_views, static_cast<int>(views.size()));
+  EXPECT_EQ(result.num_components, 1);
+  EXPECT_EQ(result.euler_characteristic, 0);  // a torus
+  for (const char* name : {"fused.ply", "fused.ply.vis", "meshed-hair.ply",
+                           "meshed-coarse-template.ply", "meshed-refined-template.ply"}) {
+    EXPECT_TRUE(ExistsFile(JoinPaths(dir, name))) << name;
+  }
+
+  // fused.ply: on the torus, with .vis indices in image_idx order (ids were reversed: the
+  // view i is image_idx n-1-i), each point seen by a view where it agrees with that depth.
+  const std::vector<FusedPoint> points = ReadFusedPly(result.fused_path);
+  ASSERT_EQ(static_cast<int>(points.size()), result.num_fused_points);
+  const int n = static_cast<int>(views.size());
+  int num_pairs = 0, num_agree = 0;
+  for (const FusedPoint& p : points) {
+    EXPECT_LT(testing::SurfaceDistance(sdf, p.xyz.cast<double>()), 0.03);
+    ASSERT_FALSE(p.visible_image_idxs.empty());
+    for (uint32_t idx : p.visible_image_idxs) {
+      ASSERT_LT(idx, static_cast<uint32_t>(n));
+      const FusionView& view = views[n - 1 - idx];
+      int col, row;
+      double z;
+      ++num_pairs;
+      // Merged points are voxel averages (2 pixels): the average may fall on a silhouette
+      // pixel, hence a fraction, not every pair.
+      num_agree += view.Project(p.xyz.cast<double>(), &col, &row, &z) &&
+                   std::abs(view.depth.At(row, col) - z) < 0.05 * z;
+    }
+  }
+  EXPECT_GT(num_agree, 0.95 * num_pairs) << num_agree << " of " << num_pairs;
+
+  // meshed-hair.ply: normals and colours per vertex, near the torus.
+  const TriangleMesh mesh = ReadMeshPly(result.mesh_path);
+  EXPECT_EQ(static_cast<int>(mesh.vertices.size()), result.final_num_vertices);
+  EXPECT_EQ(mesh.normals.size(), mesh.vertices.size());
+  EXPECT_EQ(mesh.colors.size(), mesh.vertices.size());
+  double mean_error = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    mean_error += testing::SurfaceDistance(sdf, v.cast<double>());
+  }
+  mean_error /= mesh.vertices.size();
+  EXPECT_LT(mean_error, 0.02);
+
+  // colmap reads our fused.ply (with its .vis) and meshes it.
+  const char* colmap = HAIRMVS_COLMAP_EXECUTABLE;
+  if (!ExistsFile(colmap)) GTEST_SKIP() << "no colmap binary at " << colmap;
+  const std::string colmap_mesh = JoinPaths(dir, "meshed-poisson.ply");
+  const std::string log = JoinPaths(dir, "colmap.log");
+  const std::string command = std::string("QT_QPA_PLATFORM=offscreen '") + colmap +
+                              "' poisson_mesher --input_path " + result.fused_path +
+                              " --output_path " + colmap_mesh +
+                              " --PoissonMeshing.depth 6 --PoissonMeshing.trim 0"
+                              " --PoissonMeshing.num_threads 1 > '" + log + "' 2>&1";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << ReadTextFile(log);
+  const TriangleMesh colmap_result = ReadMeshPly(colmap_mesh);
+  EXPECT_GT(colmap_result.vertices.size(), 100u);
+  EXPECT_GT(colmap_result.faces.size(), 100u);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(FusionWorkspace, NoDepthMapsIsAnErrorNamingTheFolder) {
+  const std::string dir = MakeTempDir("empty");
+  testing::SceneOptions scene;
+  scene.width = 16;
+  scene.height = 12;
+  scene.focal_px = 15;
+  scene.num_azimuths = 2;
+  scene.elevations_deg = {0};
+  WriteWorkspace(testing::RenderViews(testing::SphereSdf(1.0), scene), dir);
+  std::filesystem::remove_all(JoinPaths(dir, "stereo"));
+  try {
+    RunTemplateFusion(dir, TemplateFusionOptions(), nullptr);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("stereo"), std::string::npos) << e.what();
+  }
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hairmvs
