@@ -90,7 +90,15 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
 OrientationStereoOptions TestOptions() {
   OrientationStereoOptions options;
   options.num_depths = 64;
-  options.mrf_max_cycles = 2;
+  // 96 x 72 views: the coarse MRF on the half-size grid (level 2 would be 24 x 18).
+  options.coarse_level = 1;
+  // The rendered fields have |O| = 1 on strands (real ones are weaker): costs are about 10x
+  // those of the shared sets, and so is the smoothness weight.
+  options.lambda = 0.02;
+  // Windows 7/11/15 from fine to coarse: a 15 px window at level 0 spans a sixth of these
+  // images, and its fronto-parallel bias shows on the sphere (10.6 mm median).
+  options.window_px_level0 = 7;
+  options.window_px_level2 = 15;
   return options;
 }
 
