@@ -41,6 +41,9 @@ struct TemplateFusionOptions {
   // Trim low-density parts: faces farther than this many octree cells from every input
   // sample are where Poisson closed the surface without data (neck, crown seen by no view).
   double trim_distance_cells = 1.0;
+  // ... but never closer than this many sample spacings (the voxel the samples were merged
+  // on), for depth maps coarser than the octree.
+  double trim_min_sample_spacings = 1.5;
   // Connected components with fewer faces than this fraction of the largest are dropped.
   double min_component_fraction = 0.05;
   // Before refinement the template is subdivided (midpoint) until its mean edge is at most
@@ -96,6 +99,8 @@ struct TemplateFusionOptions {
       "voxel size of the points given to Poisson, in octree cells");
     v("trim_distance_cells", &trim_distance_cells,
       "trim faces farther than this from every sample, in octree cells");
+    v("trim_min_sample_spacings", &trim_min_sample_spacings,
+      "minimum trim distance, in sample spacings");
     v("min_component_fraction", &min_component_fraction,
       "drop components smaller than this fraction of the largest");
     v("target_edge_length_px", &target_edge_length_px,

@@ -61,9 +61,11 @@ FusionMesh PoissonTemplate(const FusionPoints& samples, const TemplateFusionOpti
   // closed the surface (it is watertight by construction), e.g. under the hair or at the crown.
   const PointKdTree tree(cloud.points_);
   // Samples may be sparser than the octree (fine octree, coarse depth maps): never trim
-  // closer than 1.5 sample spacings.
+  // closer than trim_min_sample_spacings.
   const double max_sq_dist =
-      std::pow(std::max(options.trim_distance_cells * cell_m, 1.5 * sample_spacing_m), 2);
+      std::pow(std::max(options.trim_distance_cells * cell_m,
+                        options.trim_min_sample_spacings * sample_spacing_m),
+               2);
   std::vector<bool> keep(mesh.faces.size());
   for (size_t f = 0; f < mesh.faces.size(); ++f) {
     const Eigen::Vector3i& face = mesh.faces[f];

@@ -13,8 +13,9 @@ double PoissonCellSize(const FusionPoints& points, const TemplateFusionOptions& 
 
 // Poisson at options.poisson_depth on `samples` (with normals), then trimmed: faces farther
 // than trim_distance_cells from every sample, and components smaller than
-// min_component_fraction of the largest, are removed (never closer than 1.5 times
-// `sample_spacing_m`, the voxel size the samples were merged on). Empty if nothing is left.
+// min_component_fraction of the largest, are removed (never closer than
+// trim_min_sample_spacings times `sample_spacing_m`, the voxel size the samples were merged
+// on). Empty if nothing is left.
 FusionMesh PoissonTemplate(const FusionPoints& samples, const TemplateFusionOptions& options,
                            double cell_m, double sample_spacing_m);
 

@@ -68,6 +68,8 @@ bool TemplateFusionOptions::Check(std::string* error) const {
   CHECK_OPTION(poisson_scale >= 1, "TemplateFusion.poisson_scale must be >= 1");
   CHECK_OPTION(poisson_sample_cells > 0, "TemplateFusion.poisson_sample_cells must be > 0");
   CHECK_OPTION(trim_distance_cells > 0, "TemplateFusion.trim_distance_cells must be > 0");
+  CHECK_OPTION(trim_min_sample_spacings >= 0,
+               "TemplateFusion.trim_min_sample_spacings must be >= 0");
   CHECK_OPTION(min_component_fraction >= 0 && min_component_fraction <= 1,
                "TemplateFusion.min_component_fraction must be in [0, 1]");
   CHECK_OPTION(target_edge_length_px > 0, "TemplateFusion.target_edge_length_px must be > 0");
