@@ -1,0 +1,193 @@
+// hairmvs pipeline: orientation fields, orientation stereo and template fusion in turn, on a
+// COLMAP dense workspace; from a user's own photos, `colmap image_undistorter` first.
+
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "hairmvs/evaluation.h"
+#include "hairmvs/orientation_fields.h"
+#include "hairmvs/orientation_stereo.h"
+#include "hairmvs/template_fusion.h"
+#include "src/cli/command_registry.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/option_parser.h"
+#include "src/core/timer.h"
+#include "src/opencl/opencl_options.h"
+
+namespace hairmvs {
+namespace {
+
+bool HasStage(const std::vector<std::string>& stages, const std::string& stage) {
+  for (const std::string& s : stages) {
+    if (s == stage) return true;
+  }
+  return false;
+}
+
+// Quotes a path for /bin/sh.
+std::string ShellQuote(const std::string& text) {
+  std::string quoted = "'";
+  for (char c : text) {
+    if (c == '\'') quoted += "'\\''";
+    else quoted += c;
+  }
+  return quoted + "'";
+}
+
+// Runs `colmap image_undistorter` so that `workspace_path` becomes a COLMAP dense workspace.
+void RunImageUndistorter(const std::string& colmap, const std::string& image_path,
+                         const std::string& input_path, const std::string& workspace_path) {
+  RequireDir(image_path, "image folder (--image_path)");
+  RequireDir(input_path, "sparse model folder (--input_path)");
+  CreateDirs(workspace_path);
+  const std::string command = "QT_QPA_PLATFORM=offscreen " + ShellQuote(colmap) +
+                              " image_undistorter --image_path " + ShellQuote(image_path) +
+                              " --input_path " + ShellQuote(input_path) + " --output_path " +
+                              ShellQuote(workspace_path) + " --output_type COLMAP";
+  std::fprintf(stderr, "[pipeline] %s\n", command.c_str());
+  const int status = std::system(command.c_str());
+  THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
+                            << status << ") for --image_path " << image_path
+                            << " --input_path " << input_path
+                            << "; is COLMAP installed (apt-get install colmap)?");
+}
+
+int RunPipeline(int argc, char** argv) {
+  std::string workspace_path;
+  std::string image_path;
+  std::string input_path;
+  std::string ground_truth_path;
+  std::string colmap_executable = "colmap";
+  std::vector<std::string> image_names;
+  std::vector<std::string> stages = {"orientation", "stereo", "fusion"};
+  bool write_png = true;
+  OpenCLOptions opencl_options;
+  OrientationFieldOptions orientation_options;
+  OrientationStereoOptions stereo_options;
+  TemplateFusionOptions fusion_options;
+
+  OptionParser parser("pipeline",
+                      "orientation fields, orientation stereo and template fusion on a COLMAP "
+                      "dense workspace (runs colmap image_undistorter first when --image_path "
+                      "and --input_path are given and the workspace does not exist yet)");
+  parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
+  parser.Add("image_path", &image_path, "your photos (only to create the workspace)");
+  parser.Add("input_path", &input_path,
+             "sparse model from colmap mapper (only to create the workspace)");
+  parser.Add("colmap_executable", &colmap_executable, "colmap binary for image_undistorter");
+  parser.Add("image_names", &image_names,
+             "reference views to process (comma-separated; empty = all). With a subset, the "
+             "fusion stage is skipped: run `hairmvs template_fusion` once all views are done");
+  parser.Add("stages", &stages, "stages to run, in order: orientation,stereo,fusion");
+  parser.Add("ground_truth_path", &ground_truth_path,
+             "a synthetic data set's gt/ folder: evaluate depth maps and mesh at the end");
+  parser.Add("write_png", &write_png, "write orientation, depth and normal pictures");
+  parser.AddSection("OpenCL", &opencl_options);
+  parser.AddSection("OrientationField", &orientation_options);
+  parser.AddSection("OrientationStereo", &stereo_options);
+  parser.AddSection("TemplateFusion", &fusion_options);
+  if (!parser.Parse(argc, argv)) return 0;
+
+  std::string error;
+  THROW_IF(!orientation_options.Check(&error), "--OrientationField: " << error);
+  THROW_IF(!stereo_options.Check(&error), "--OrientationStereo: " << error);
+  THROW_IF(!fusion_options.Check(&error), "--TemplateFusion: " << error);
+  for (const std::string& stage : stages) {
+    THROW_IF(stage != "orientation" && stage != "stereo" && stage != "fusion",
+             "--stages: unknown stage '" << stage << "' (orientation, stereo, fusion)");
+  }
+
+  Timer total;
+  StageTimings timings;
+  const std::string sparse_path = JoinPaths(workspace_path, "sparse");
+  if (!ExistsDir(sparse_path)) {
+    THROW_IF(image_path.empty() || input_path.empty(),
+             "No COLMAP dense workspace at " << workspace_path << " (missing " << sparse_path
+                                             << "); give --image_path and --input_path to "
+                                                "create it with colmap image_undistorter");
+    ScopedStageTimer timer(&timings, "image_undistorter");
+    RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
+  }
+
+  const int num_stages = static_cast<int>(stages.size());
+  int stage_index = 0;
+  auto announce = [&](const std::string& stage) {
+    std::fprintf(stderr, "[pipeline] stage %d/%d: %s (%.1f s elapsed)\n", ++stage_index,
+                 num_stages, stage.c_str(), total.ElapsedSeconds());
+  };
+
+  if (HasStage(stages, "orientation")) {
+    announce("orientation fields");
+    OrientationFieldsRunOptions run_options;
+    run_options.image_names = image_names;
+    run_options.write_png = write_png;
+    run_options.opencl_device = opencl_options.device;
+    const OrientationFieldsResult result =
+        RunOrientationFields(workspace_path, orientation_options, run_options, &timings);
+    std::printf("%s\n", result.BriefReport().c_str());
+  }
+  if (HasStage(stages, "stereo")) {
+    announce("orientation stereo");
+    stereo_options.write_png = stereo_options.write_png || write_png;
+    const OrientationStereoResult result = RunOrientationStereo(
+        workspace_path, image_names, stereo_options, &timings, opencl_options.device);
+    std::printf("%s\n", result.BriefReport().c_str());
+  }
+  if (HasStage(stages, "fusion")) {
+    if (!image_names.empty()) {
+      std::fprintf(stderr,
+                   "[pipeline] --image_names given: skipping fusion (run `hairmvs "
+                   "template_fusion --workspace_path %s` once every view is done)\n",
+                   workspace_path.c_str());
+    } else {
+      announce("template fusion");
+      const TemplateFusionResult result =
+          RunTemplateFusion(workspace_path, fusion_options, &timings);
+      std::printf("%s\n", result.BriefReport().c_str());
+    }
+  }
+
+  if (!ground_truth_path.empty()) {
+    std::fprintf(stderr, "[pipeline] evaluation against %s\n", ground_truth_path.c_str());
+    DepthEvaluationOptions depth_options;
+    depth_options.image_names = image_names;
+    {
+      ScopedStageTimer timer(&timings, "evaluate_depth");
+      const DepthEvaluationResult depth = EvaluateDepthMaps(workspace_path, ground_truth_path,
+                                                            depth_options);
+      std::printf("%s\n", depth.Table().c_str());
+    }
+    const std::string mesh_path = JoinPaths(workspace_path, "meshed-hair.ply");
+    if (ExistsFile(mesh_path)) {
+      ScopedStageTimer timer(&timings, "evaluate_mesh");
+      const MeshEvaluationResult mesh =
+          EvaluateMesh(mesh_path, ground_truth_path, workspace_path, MeshEvaluationOptions());
+      std::printf("%s\n", mesh.Report().c_str());
+    }
+  }
+
+  std::printf("%s", timings.Table("hairmvs pipeline: time per stage").c_str());
+  std::printf("peak memory: %.0f MiB, wall time: %.1f s\n", PeakResidentMemoryMiB(),
+              total.ElapsedSeconds());
+  std::printf(
+      "Look at:\n"
+      "  %s/stereo/orientation_maps/*.png   orientation fields (hue = strand angle)\n"
+      "  %s/stereo/depth_maps/*.png, normal_maps/*.png   depth and normal pictures\n"
+      "  %s/stereo/evaluation/*.png   error pictures (with --ground_truth_path)\n"
+      "  %s/meshed-hair.ply   the hair surface (MeshLab, or COLMAP's GUI with sparse/)\n",
+      workspace_path.c_str(), workspace_path.c_str(), workspace_path.c_str(),
+      workspace_path.c_str());
+  return 0;
+}
+
+}  // namespace
+
+HAIRMVS_REGISTER_COMMAND("pipeline", RunPipeline,
+                         "orientation fields + orientation stereo + template fusion on a "
+                         "workspace (or from your photos via colmap image_undistorter)");
+
+}  // namespace hairmvs
