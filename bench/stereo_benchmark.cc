@@ -1,0 +1,64 @@
+// Throughput of the stereo kernels on PoCL: the orientation cost volume and the guided filter
+// for one block of depth slices at 960 x 640 (the gantry set's size), 3 source views.
+// Run: ./build-stereo/bench/stereo_benchmark
+
+#include <benchmark/benchmark.h>
+
+#include "src/opencl/opencl_context.h"
+#include "src/stereo/cost_volume.h"
+#include "src/stereo/guided_filter.h"
+#include "src/stereo/stereo_test_util.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::LookAtCamera;
+using testing_util::RandomMap;
+
+constexpr int kWidth = 960, kHeight = 640, kSlices = 8;
+
+void BM_OrientationCostVolume(benchmark::State& state) {
+  auto context = OpenCLContext::Create();
+  const CostViewInput ref{LookAtCamera({0, 0, 0}, {0, 0, 0.6}, 768, kWidth, kHeight),
+                          RandomMap(kWidth, kHeight, 2, 1)};
+  std::vector<CostViewInput> sources;
+  const Eigen::Vector3d centers[3] = {{0.1, 0, 0}, {-0.1, 0, 0}, {0, 0.1, 0}};
+  for (int v = 0; v < 3; ++v) {
+    sources.push_back({LookAtCamera(centers[v], {0, 0, 0.6}, 768, kWidth, kHeight),
+                       RandomMap(kWidth, kHeight, 2, 2 + v)});
+  }
+  CostVolumeCL volume(context.get(), StereoCost::kOrientation, ref, sources);
+  const DepthLabels labels(0.4, 0.8, 64, true);
+  std::vector<float> base(kWidth * kHeight, 0.0f);
+  cl::Buffer base_buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                         sizeof(float) * base.size(), base.data());
+  cl::Buffer out(context->Context(), CL_MEM_READ_WRITE,
+                 sizeof(float) * base.size() * kSlices);
+  for (auto _ : state) {
+    volume.Compute(base_buffer, 1.0f, 0, kSlices, labels, out);
+    context->Queue().finish();
+  }
+  state.counters["Mpixel_slices/s"] = benchmark::Counter(
+      1e-6 * kWidth * kHeight * kSlices, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_OrientationCostVolume)->Unit(benchmark::kMillisecond);
+
+void BM_GuidedFilter(benchmark::State& state) {
+  auto context = OpenCLContext::Create();
+  GuidedFilterCL filter(context.get(), RandomMap(kWidth, kHeight, 2, 7),
+                        static_cast<int>(state.range(0)), 0.12f);
+  const FloatMap input = RandomMap(kWidth, kHeight, kSlices, 8);
+  cl::Buffer buffer(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                    sizeof(float) * input.Data().size(), const_cast<float*>(input.Data().data()));
+  for (auto _ : state) {
+    filter.Filter(buffer, kSlices, buffer);
+    context->Queue().finish();
+  }
+  state.counters["Mpixel_slices/s"] = benchmark::Counter(
+      1e-6 * kWidth * kHeight * kSlices, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_GuidedFilter)->Arg(3)->Arg(7)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+}  // namespace hairmvs
+BENCHMARK_MAIN();
