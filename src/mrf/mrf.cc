@@ -107,7 +107,8 @@ int PolishWithIcm(const MrfProblem& problem, int max_iterations, std::vector<int
   const float* offset = problem.label_offset.empty() ? zeros.data() : problem.label_offset.data();
   const float* weight_right =
       problem.weight_right.empty() ? zeros.data() : problem.weight_right.data();
-  const float* weight_down = problem.weight_down.empty() ? zeros.data() : problem.weight_down.data();
+  const float* weight_down =
+      problem.weight_down.empty() ? zeros.data() : problem.weight_down.data();
   const float step = problem.label_step;
   const float truncation = std::min(problem.truncation, std::numeric_limits<float>::max());
   int* lab = labels->data();

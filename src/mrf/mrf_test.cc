@@ -213,7 +213,8 @@ TEST(GraphCuts, NonSubmodularMovesNeverIncreaseTheEnergy) {
 TEST(GraphCuts, StereoLikeProblemsAgainstOtherSolvers) {
   for (int num_labels : {8, 16}) {
     for (float lambda : {0.2f, 1.0f}) {
-      const MrfProblem problem = SyntheticStereoMrfProblem(24, 20, num_labels, lambda, 7 + num_labels);
+      const MrfProblem problem =
+          SyntheticStereoMrfProblem(24, 20, num_labels, lambda, 7 + num_labels);
       const double wta = MrfEnergy(problem, WinnerTakeAll(problem));
       const MrfResult gc = Solve(problem, MrfSolverType::kGraphCuts);
       EXPECT_LT(gc.energy, wta);
@@ -227,7 +228,8 @@ TEST(GraphCuts, StereoLikeProblemsAgainstOtherSolvers) {
       const MrfResult sgm8 = Solve(problem, MrfSolverType::kSemiGlobalCpu, nullptr, 8);
       const MrfResult sgm8_icm = Solve(problem, MrfSolverType::kSemiGlobalCpu, nullptr, 8, 100);
       const MrfResult bp = Solve(problem, MrfSolverType::kBeliefPropagationCpu);
-      const MrfResult bp_icm = Solve(problem, MrfSolverType::kBeliefPropagationCpu, nullptr, 8, 100);
+      const MrfResult bp_icm =
+          Solve(problem, MrfSolverType::kBeliefPropagationCpu, nullptr, 8, 100);
       EXPECT_GE(icm.energy, gc.energy * 0.999);
       EXPECT_LE(sgm8_icm.energy, gc.energy * (lambda < 0.5f ? 1.03 : 1.25));
       EXPECT_LE(sgm8.energy, gc.energy * 2.0);
@@ -237,7 +239,8 @@ TEST(GraphCuts, StereoLikeProblemsAgainstOtherSolvers) {
       EXPECT_LE(bp_icm.energy, bp.energy + 1e-9);
       LOG(INFO) << "L=" << num_labels << " lambda=" << lambda << ": E/E_gc wta "
                 << wta / gc.energy << ", icm " << icm.energy / gc.energy << ", sgm4 "
-                << sgm4.energy / gc.energy << ", sgm8 " << sgm8.energy / gc.energy << ", sgm8+icm " << sgm8_icm.energy / gc.energy << ", bp " << bp.energy / gc.energy
+                << sgm4.energy / gc.energy << ", sgm8 " << sgm8.energy / gc.energy
+                << ", sgm8+icm " << sgm8_icm.energy / gc.energy << ", bp " << bp.energy / gc.energy
                 << ", bp+icm " << bp_icm.energy / gc.energy
                 << " (gc cycles " << gc.cycles << ")";
     }
