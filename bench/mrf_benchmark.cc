@@ -40,6 +40,7 @@ MrfSolverOptions GraphCutOptions() {
   options.solver = MrfSolverType::kGraphCuts;
   options.max_cycles = 3;
   options.graph_cuts_init_semi_global = false;
+  options.icm_polish_iterations = 0;
   return options;
 }
 
@@ -117,6 +118,7 @@ void BM_Icm(benchmark::State& state) {
   MrfSolverOptions options;
   options.solver = MrfSolverType::kIcm;
   options.max_cycles = 20;
+  options.icm_polish_iterations = 0;
   RunSolver(state, options);
 }
 
