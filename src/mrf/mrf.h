@@ -107,8 +107,9 @@ struct MrfSolverOptions {
   // belief_propagation*: message-passing iterations (each updates both checkerboard colours).
   int bp_iterations = 30;
   // Any solver: ICM sweeps run on its result (0 = none); never increases E. Cheap (0.07-0.12 s
-  // of CPU per sweep per Mpixel at 16-32 labels, stops at the first sweep that changes nothing) and needed by
-  // semi_global, whose labels alone are 1.37x graph cuts' energy at 1 Mpixel (1.04x after).
+  // of CPU per sweep per Mpixel at 16-32 labels; stops at the first sweep that changes
+  // nothing) and needed by semi_global, whose labels alone are 1.37x graph cuts' energy at
+  // 1 Mpixel (1.04x after).
   int icm_polish_iterations = 10;
   // graph_cuts: start from semi-global matching + ICM (OpenCL when a context is given, else
   // the CPU reference) instead of winner-take-all: cheaper max-flows (measured at 1 Mpixel,
