@@ -380,13 +380,17 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
 // ---------------------------------------------------------------------------------------------
 // Depth ranges.
 
-DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id) {
+namespace {
+
+// COLMAP's percentile rule on the depths of the points that `keep` accepts.
+template <typename KeepFn>
+DepthRange DepthRangeOfPoints(const Reconstruction& model, uint32_t image_id, KeepFn keep) {
   const Image& image = model.images.at(image_id);
   const Eigen::Matrix3d R = image.R();
   std::vector<double> depths;
   for (const auto& [point_id, point] : model.points3D) {
     for (const TrackElement& el : point.track) {
-      if (el.image_id != image_id) continue;
+      if (el.image_id != image_id || !keep(el)) continue;
       const double d = R.row(2).dot(point.xyz) + image.t().z();
       if (d > 0) depths.push_back(d);
     }
@@ -399,6 +403,30 @@ DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id) {
   range.min_m = 0.75 * depths[static_cast<size_t>(0.01 * n)];
   range.max_m = 1.25 * depths[std::min(n - 1, static_cast<size_t>(0.99 * n))];
   return range;
+}
+
+}  // namespace
+
+DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id) {
+  return DepthRangeOfPoints(model, image_id, [](const TrackElement&) { return true; });
+}
+
+DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
+                             const FloatMap& mask, int min_points) {
+  const Image& image = model.images.at(image_id);
+  const Camera& camera = model.cameras.at(image.camera_id);
+  const double sx = static_cast<double>(mask.Width()) / camera.width;
+  const double sy = static_cast<double>(mask.Height()) / camera.height;
+  const DepthRange masked = DepthRangeOfPoints(model, image_id, [&](const TrackElement& el) {
+    if (el.point2D_idx >= image.points2D.size()) return false;
+    const Eigen::Vector2d& xy = image.points2D[el.point2D_idx].xy;
+    const int col = static_cast<int>(std::floor(xy.x() * sx));
+    const int row = static_cast<int>(std::floor(xy.y() * sy));
+    return col >= 0 && row >= 0 && col < mask.Width() && row < mask.Height() &&
+           mask.At(row, col) > 0.0f;
+  });
+  if (masked.num_points >= min_points) return masked;
+  return ComputeDepthRange(model, image_id);
 }
 
 DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,

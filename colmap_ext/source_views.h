@@ -100,6 +100,12 @@ struct DepthRange {
 // COLMAP's Model::ComputeDepthRanges: depths d > 0 of the sparse points in the image's tracks,
 // sorted; [0.75 * d[floor(0.01 n)], 1.25 * d[floor(0.99 n)]]; (-1, -1) when there are none.
 DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id);
+// The same rule over the sparse points whose observation in this image falls inside `mask`
+// (1 = keep; any size: observations are scaled from the camera's size to the mask's). A hair
+// mask thus keeps the room behind the subject out of the range. Falls back to all points when
+// fewer than `min_points` observations are inside the mask.
+DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
+                             const FloatMap& mask, int min_points = 10);
 // The depth range to use: options.depth_min / depth_max when both are set (> 0), else
 // ComputeDepthRange. Throws hairmvs::Error when neither gives a range.
 DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,

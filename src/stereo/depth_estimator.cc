@@ -74,7 +74,59 @@ MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
   return mrf;
 }
 
+// Window sums by a summed-area table (double, so long rows do not lose precision).
+void BoxSums(const float* in, int width, int height, int radius, std::vector<double>* sums,
+             std::vector<double>* table) {
+  const int w1 = width + 1;
+  table->assign(static_cast<size_t>(w1) * (height + 1), 0.0);
+  for (int r = 0; r < height; ++r) {
+    double row_sum = 0;
+    for (int c = 0; c < width; ++c) {
+      row_sum += in[r * width + c];
+      (*table)[(r + 1) * w1 + c + 1] = (*table)[r * w1 + c + 1] + row_sum;
+    }
+  }
+  sums->resize(static_cast<size_t>(width) * height);
+  for (int r = 0; r < height; ++r) {
+    const int r0 = std::max(0, r - radius), r1 = std::min(height, r + radius + 1);
+    for (int c = 0; c < width; ++c) {
+      const int c0 = std::max(0, c - radius), c1 = std::min(width, c + radius + 1);
+      (*sums)[r * width + c] = (*table)[r1 * w1 + c1] - (*table)[r0 * w1 + c1] -
+                               (*table)[r1 * w1 + c0] + (*table)[r0 * w1 + c0];
+    }
+  }
+}
+
 }  // namespace
+
+FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps) {
+  CHECK_EQ(orientation.Channels(), 2);
+  const int width = orientation.Width(), height = orientation.Height();
+  const size_t n = orientation.NumPixels();
+  // Means over the valid (non-zero) pixels of each window, so that mask borders do not bias.
+  std::vector<float> valid(n), sq(n);
+  for (size_t i = 0; i < n; ++i) {
+    const float re = orientation.Channel(0)[i], im = orientation.Channel(1)[i];
+    valid[i] = (re != 0.0f || im != 0.0f) ? 1.0f : 0.0f;
+    sq[i] = re * re + im * im;
+  }
+  std::vector<double> count, sum_re, sum_im, sum_sq, table;
+  BoxSums(valid.data(), width, height, radius, &count, &table);
+  BoxSums(orientation.Channel(0), width, height, radius, &sum_re, &table);
+  BoxSums(orientation.Channel(1), width, height, radius, &sum_im, &table);
+  BoxSums(sq.data(), width, height, radius, &sum_sq, &table);
+  FloatMap out(width, height, 2, 0.0f);
+  for (size_t i = 0; i < n; ++i) {
+    if (valid[i] == 0.0f || count[i] < 1) continue;
+    const double mean_re = sum_re[i] / count[i], mean_im = sum_im[i] / count[i];
+    const double variance =
+        std::max(0.0, sum_sq[i] / count[i] - mean_re * mean_re - mean_im * mean_im);
+    const double scale = 1.0 / std::sqrt(variance + eps);
+    out.Channel(0)[i] = static_cast<float>((orientation.Channel(0)[i] - mean_re) * scale);
+    out.Channel(1)[i] = static_cast<float>((orientation.Channel(1)[i] - mean_im) * scale);
+  }
+  return out;
+}
 
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
                                const std::vector<const StereoViewData*>& sources,
@@ -100,10 +152,14 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   {
     ScopedStageTimer timer(timings, "cost volume");
     for (int l = 0; l < num_levels; ++l) {
-      CostViewInput ref_in{ref.camera, photometric ? ref.rgb[l] : ref.orientation[l]};
+      auto matched = [photometric, l](const StereoViewData& view) -> const FloatMap& {
+        if (photometric) return view.rgb[l];
+        return view.matching.empty() ? view.orientation[l] : view.matching[l];
+      };
+      CostViewInput ref_in{ref.camera, matched(ref)};
       std::vector<CostViewInput> src_in;
       for (const StereoViewData* src : sources) {
-        src_in.push_back({src->camera, photometric ? src->rgb[l] : src->orientation[l]});
+        src_in.push_back({src->camera, matched(*src)});
       }
       levels[l].cost = std::make_unique<CostVolumeCL>(context, options.cost, ref_in, src_in,
                                                       options.roll_correction,

@@ -19,8 +19,19 @@ class Progress;
 struct StereoViewData {
   StereoCamera camera;                 // at the processing resolution (= level 0)
   std::vector<FloatMap> orientation;   // per level, 2 channels (Re O, Im O)
+  // What the orientation cost matches, per level: `orientation` itself (the paper), or its
+  // local normalisation (NormalizeOrientationField). Empty = `orientation`. The guide of the
+  // aggregation and the smoothness weights always use `orientation`.
+  std::vector<FloatMap> matching;
   std::vector<FloatMap> rgb;           // per level, 3 channels (photometric cost only)
 };
+
+// Local normalisation of an orientation field for matching: (O - mean_w(O)) / sqrt(mean_w(|O -
+// mean_w(O)|^2) + eps), window (2 radius + 1)^2, 0 where O = 0 (masked or dark pixels). The
+// paper's cost -Re(O_ref* O_v) is a product of confidences, so bright, high-contrast regions of
+// a source view win whatever their alignment; normalised fields make the aggregated cost a
+// correlation of the orientation textures (a zero-mean NCC of the complex fields).
+FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps);
 
 struct DepthEstimate {
   FloatMap depth;       // z-depth on the level-0 grid, 0 = invalid

@@ -61,7 +61,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   for (const StereoCamera& camera : cameras) {
     const testing_util::RenderedView view = RenderView(camera, surface, strands);
     if (true_depth.Empty()) true_depth = view.depth;
-    views.push_back({camera, Pyramid(view.orientation, 3), {}});
+    views.push_back({camera, Pyramid(view.orientation, 3), {}, {}});
   }
   std::vector<const StereoViewData*> sources;
   for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
@@ -151,6 +151,57 @@ TEST(DepthEstimator, EpipoleRollCorrectionIsNeededForARolledSource) {
   EXPECT_GT(without.median_abs_error_m, 3 * with.median_abs_error_m);
   std::printf("roll 60 deg: median |error| %.4f m with the correction, %.4f m without\n",
               with.median_abs_error_m, without.median_abs_error_m);
+}
+
+}  // namespace
+}  // namespace hairmvs
+
+namespace hairmvs {
+namespace {
+
+// The local normalisation against explicit window sums: zero mean and unit variance (up to
+// eps) over each window of valid pixels; masked (zero) pixels stay zero.
+TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {
+  const int width = 13, height = 9, radius = 2;
+  const float eps = 1e-3f;
+  FloatMap field(width, height, 2);
+  uint32_t state = 12345;
+  auto next = [&state] {
+    state = state * 1664525u + 1013904223u;
+    return static_cast<float>(state >> 8) / 16777216.0f - 0.5f;
+  };
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const bool masked = (r * width + c) % 7 == 0;
+      field.At(r, c, 0) = masked ? 0.0f : next();
+      field.At(r, c, 1) = masked ? 0.0f : next();
+    }
+  }
+  const FloatMap normalized = NormalizeOrientationField(field, radius, eps);
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      if (field.At(r, c, 0) == 0.0f && field.At(r, c, 1) == 0.0f) {
+        EXPECT_EQ(normalized.At(r, c, 0), 0.0f);
+        EXPECT_EQ(normalized.At(r, c, 1), 0.0f);
+        continue;
+      }
+      double n = 0, sre = 0, sim = 0, ssq = 0;
+      for (int rr = std::max(0, r - radius); rr <= std::min(height - 1, r + radius); ++rr) {
+        for (int cc = std::max(0, c - radius); cc <= std::min(width - 1, c + radius); ++cc) {
+          const double re = field.At(rr, cc, 0), im = field.At(rr, cc, 1);
+          if (re == 0.0 && im == 0.0) continue;
+          n += 1;
+          sre += re;
+          sim += im;
+          ssq += re * re + im * im;
+        }
+      }
+      const double mre = sre / n, mim = sim / n;
+      const double scale = 1.0 / std::sqrt(ssq / n - mre * mre - mim * mim + eps);
+      EXPECT_NEAR(normalized.At(r, c, 0), (field.At(r, c, 0) - mre) * scale, 1e-4);
+      EXPECT_NEAR(normalized.At(r, c, 1), (field.At(r, c, 1) - mim) * scale, 1e-4);
+    }
+  }
 }
 
 }  // namespace

@@ -269,6 +269,14 @@ class ViewLoader {
         }
       }
     }
+    if (options_.cost == StereoCost::kOrientation &&
+        options_.orientation_normalization_radius_px > 0) {
+      for (const FloatMap& level : data.orientation) {
+        data.matching.push_back(NormalizeOrientationField(
+            level, options_.orientation_normalization_radius_px,
+            static_cast<float>(options_.orientation_normalization_eps)));
+      }
+    }
     if (options_.cost == StereoCost::kPhotometric) {
       data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
       for (int l = 1; l < options_.num_levels; ++l) data.rgb.push_back(DownsampleRgb(data.rgb.back()));
@@ -333,10 +341,14 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     std::vector<const StereoViewData*> sources;
     for (const StereoViewData& s : source_data) sources.push_back(&s);
 
+    const FloatMap mask =
+        loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
     double depth_min = options.depth_min, depth_max = options.depth_max;
     if (depth_min <= 0 || depth_max <= 0) {
-      const DepthRange range =
-          ComputeDepthRange(workspace.Model(), workspace.ImageByName(name).image_id);
+      const uint32_t image_id = workspace.ImageByName(name).image_id;
+      const DepthRange range = options.depth_range_from_mask
+                                   ? ComputeDepthRange(workspace.Model(), image_id, mask)
+                                   : ComputeDepthRange(workspace.Model(), image_id);
       if (depth_min <= 0) depth_min = range.min_m;
       if (depth_max <= 0) depth_max = range.max_m;
     }
@@ -345,8 +357,6 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                   << "--OrientationStereo.depth_min and depth_max");
     const DepthLabels labels(depth_min, depth_max, options.num_depths,
                              options.depth_sampling == DepthSampling::kInverseDepth);
-    const FloatMap mask =
-        loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
     const DepthEstimate estimate =
         EstimateDepthMap(context.get(), ref, sources, mask, labels, options, timings, &progress);
 
