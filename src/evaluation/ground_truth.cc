@@ -1,7 +1,5 @@
 #include "src/evaluation/ground_truth.h"
 
-#include <nanoflann.hpp>
-
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
@@ -10,6 +8,7 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/npz.h"
+#include "src/evaluation/sample_kdtree.h"
 
 namespace hairmvs {
 namespace {
@@ -180,23 +179,12 @@ Eigen::Vector3d CatmullRom(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
 
 // --- StrandDistance ---------------------------------------------------------------------------
 
-struct StrandDistance::Index {
-  // Densified centreline samples; connected[i] says whether sample i and i+1 belong to the
-  // same strand (the polyline continues).
-  std::vector<Eigen::Vector3f> samples;
+struct StrandDistance::Index : SampleCloud {
+  // samples: the densified centreline; connected[i] says whether sample i and i+1 belong to
+  // the same strand (the polyline continues).
   std::vector<uint8_t> connected;
   double max_segment_m = 0;
-
-  size_t kdtree_get_point_count() const { return samples.size(); }
-  float kdtree_get_pt(uint32_t i, size_t dim) const { return samples[i](dim); }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Index>,
-                                                   Index, 3, uint32_t>;
-  std::unique_ptr<Tree> tree;
+  std::unique_ptr<SampleTree> tree;
 };
 
 namespace {
@@ -237,9 +225,7 @@ class NearestSegmentResult {
     }
     if (d2 < best2_) {
       best2_ = d2;
-      // Slightly generous (float rounding of the tree's distances).
-      const double r = std::sqrt(best2_) + 0.5 * index_.max_segment_m;
-      radius2_ = static_cast<float>(r * r * (1.0 + 1e-5) + 1e-14);
+      radius2_ = GenerousRadius2(std::sqrt(best2_) + 0.5 * index_.max_segment_m);
     }
     return true;
   }
@@ -298,8 +284,7 @@ StrandDistance::StrandDistance(const GroundTruthStrands& strands, double max_spa
           index_->max_segment_m, static_cast<double>((samples[i + 1] - samples[i]).norm()));
     }
   }
-  index_->tree = std::make_unique<Index::Tree>(3, *index_,
-                                               nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  index_->tree = BuildSampleTree(*index_);
 }
 
 StrandDistance::~StrandDistance() = default;
@@ -308,17 +293,11 @@ size_t StrandDistance::NumSamples() const { return index_->samples.size(); }
 
 double StrandDistance::Distance(const Eigen::Vector3d& x) const {
   NearestSegmentResult result(*index_, x);
-  const float query[3] = {static_cast<float>(x(0)), static_cast<float>(x(1)),
-                          static_cast<float>(x(2))};
-  index_->tree->findNeighbors(result, query, nanoflann::SearchParams());
-  return result.Best();
+  return NearestWithResultSet(*index_->tree, x, &result);
 }
 
 std::vector<double> StrandDistance::Distances(const std::vector<Eigen::Vector3d>& points) const {
-  std::vector<double> distances(points.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (size_t i = 0; i < points.size(); ++i) distances[i] = Distance(points[i]);
-  return distances;
+  return ParallelDistances(points, [this](const Eigen::Vector3d& x) { return Distance(x); });
 }
 
 }  // namespace hairmvs

@@ -1,7 +1,5 @@
 #include "src/evaluation/mesh_distance.h"
 
-#include <nanoflann.hpp>
-
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -9,6 +7,7 @@
 
 #include "colmap_ext/ply.h"
 #include "src/core/logging.h"
+#include "src/evaluation/sample_kdtree.h"
 
 namespace hairmvs {
 
@@ -78,22 +77,12 @@ std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double 
   return samples;
 }
 
-struct TriangleMeshDistance::Index {
-  std::vector<Eigen::Vector3f> samples;
+struct TriangleMeshDistance::Index : SampleCloud {
   std::vector<uint32_t> sample_face;
   std::vector<Eigen::Vector3d> vertices;
   std::vector<Eigen::Vector3i> faces;
   double spacing_m = 0;
-
-  size_t kdtree_get_point_count() const { return samples.size(); }
-  float kdtree_get_pt(uint32_t i, size_t dim) const { return samples[i](dim); }
-  template <class BBox>
-  bool kdtree_get_bbox(BBox&) const {
-    return false;
-  }
-  using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, Index>,
-                                                   Index, 3, uint32_t>;
-  std::unique_ptr<Tree> tree;
+  std::unique_ptr<SampleTree> tree;
 };
 
 namespace {
@@ -119,8 +108,7 @@ class NearestFaceResult {
                                            index_.vertices[f(2)]);
     if (d < best_) {
       best_ = d;
-      const double r = best_ + index_.spacing_m;
-      radius2_ = static_cast<float>(r * r * (1.0 + 1e-5) + 1e-14);
+      radius2_ = GenerousRadius2(best_ + index_.spacing_m);
     }
     return true;
   }
@@ -167,26 +155,19 @@ TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double samp
     THROW_IF(index_->samples.size() >= std::numeric_limits<uint32_t>::max(),
              "TriangleMeshDistance: too many samples; use a larger sample spacing");
   }
-  index_->tree = std::make_unique<Index::Tree>(3, *index_,
-                                               nanoflann::KDTreeSingleIndexAdaptorParams(16));
+  index_->tree = BuildSampleTree(*index_);
 }
 
 TriangleMeshDistance::~TriangleMeshDistance() = default;
 
 double TriangleMeshDistance::Distance(const Eigen::Vector3d& x) const {
   NearestFaceResult result(*index_, x);
-  const float query[3] = {static_cast<float>(x(0)), static_cast<float>(x(1)),
-                          static_cast<float>(x(2))};
-  index_->tree->findNeighbors(result, query, nanoflann::SearchParams());
-  return result.Best();
+  return NearestWithResultSet(*index_->tree, x, &result);
 }
 
 std::vector<double> TriangleMeshDistance::Distances(
     const std::vector<Eigen::Vector3d>& points) const {
-  std::vector<double> distances(points.size());
-#pragma omp parallel for schedule(dynamic, 1024)
-  for (size_t i = 0; i < points.size(); ++i) distances[i] = Distance(points[i]);
-  return distances;
+  return ParallelDistances(points, [this](const Eigen::Vector3d& x) { return Distance(x); });
 }
 
 }  // namespace hairmvs
