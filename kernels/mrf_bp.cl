@@ -16,18 +16,17 @@
 
 #pragma OPENCL FP_CONTRACT OFF
 
+#include "mrf_checkerboard.clh"
 #include "mrf_path_min.clh"
 
 __kernel void bp_colour(__global const float* cost, __global const float* offset, float step,
                         __global const float* weight_right, __global const float* weight_down,
                         float truncation, int width, int height, int colour,
                         __global float* msg) {
-  const int p = get_global_id(0);
+  int row, col;
+  const int p = mrf_checkerboard_pixel(width, height, colour, &row, &col);
+  if (p < 0) return;
   const int n = width * height;
-  if (p >= n) return;
-  const int row = p / width;
-  const int col = p - row * width;
-  if (((row + col) & 1) != colour) return;
   float h[NUM_LABELS];
   float prev[NUM_LABELS];
   float m[NUM_LABELS];

@@ -16,16 +16,16 @@
 #error "NUM_LABELS must be defined"
 #endif
 
+#include "mrf_checkerboard.clh"
+
 __kernel void icm_colour(__global const float* cost, __global const float* offset, float step,
                          __global const float* weight_right, __global const float* weight_down,
                          float truncation, int width, int height, int colour,
                          __global int* labels, __global int* changed) {
-  const int p = get_global_id(0);
+  int row, col;
+  const int p = mrf_checkerboard_pixel(width, height, colour, &row, &col);
+  if (p < 0) return;
   const int n = width * height;
-  if (p >= n) return;
-  const int row = p / width;
-  const int col = p - row * width;
-  if (((row + col) & 1) != colour) return;
   // Neighbour values and weights (weight 0 where there is no neighbour).
   float nv[4];
   float nw[4];

@@ -94,8 +94,6 @@ std::vector<int> SolveBeliefPropagationCpu(const MrfProblem& problem, int iterat
 std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int iterations,
                                               int icm_iterations, OpenCLContext* context) {
   CHECK(context != nullptr);
-  const int width = problem.width;
-  const int height = problem.height;
   const int num_labels = problem.num_labels;
   const size_t n = problem.NumPixels();
   THROW_IF(4 * n * num_labels > static_cast<size_t>(std::numeric_limits<int>::max()),
@@ -106,7 +104,6 @@ std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int ite
   const std::vector<float>& weight_right =
       problem.weight_right.empty() ? zeros : problem.weight_right;
   const std::vector<float>& weight_down = problem.weight_down.empty() ? zeros : problem.weight_down;
-  const float truncation = std::min(problem.truncation, std::numeric_limits<float>::max());
 
   cl::Context& ctx = context->Context();
   cl::CommandQueue& queue = context->Queue();
@@ -114,48 +111,35 @@ std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int ite
   cl::Program& program = context->Program({"mrf_bp.cl"}, options);
   cl::Kernel colour_kernel(program, "bp_colour");
   cl::Kernel labels_kernel(program, "bp_labels");
-  auto read_only = [&](const std::vector<float>& host) {
-    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, host.size() * sizeof(float),
-                      const_cast<float*>(host.data()));
-  };
-  cl::Buffer cost_buffer = read_only(problem.data_cost);
-  cl::Buffer offset_buffer = read_only(offset);
-  cl::Buffer right_buffer = read_only(weight_right);
-  cl::Buffer down_buffer = read_only(weight_down);
+  cl::Buffer cost_buffer = MrfReadOnlyBuffer(ctx, problem.data_cost);
+  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
+  cl::Buffer right_buffer = MrfReadOnlyBuffer(ctx, weight_right);
+  cl::Buffer down_buffer = MrfReadOnlyBuffer(ctx, weight_down);
   const size_t msg_bytes = 4 * n * num_labels * sizeof(float);
   cl::Buffer msg_buffer(ctx, CL_MEM_READ_WRITE, msg_bytes);
   cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
   queue.enqueueFillBuffer(msg_buffer, 0.0f, 0, msg_bytes);
 
-  constexpr int kLocalSize = 16;  // fixed: PoCL specialises kernels per local size
-  const cl::NDRange global((n + kLocalSize - 1) / kLocalSize * kLocalSize);
-  colour_kernel.setArg(0, cost_buffer);
-  colour_kernel.setArg(1, offset_buffer);
-  colour_kernel.setArg(2, problem.label_step);
-  colour_kernel.setArg(3, right_buffer);
-  colour_kernel.setArg(4, down_buffer);
-  colour_kernel.setArg(5, truncation);
-  colour_kernel.setArg(6, width);
-  colour_kernel.setArg(7, height);
+  const cl::NDRange global = MrfGlobalRange(n);
+  SetCheckerboardKernelArgs(&colour_kernel, cost_buffer, offset_buffer, right_buffer,
+                            down_buffer, problem);
   colour_kernel.setArg(9, msg_buffer);
   for (int iteration = 0; iteration < iterations; ++iteration) {
     for (int colour = 0; colour < 2; ++colour) {
       colour_kernel.setArg(8, colour);
-      queue.enqueueNDRangeKernel(colour_kernel, cl::NullRange, global, cl::NDRange(kLocalSize));
+      queue.enqueueNDRangeKernel(colour_kernel, cl::NullRange, global, cl::NDRange(kMrfLocalSize));
     }
   }
   labels_kernel.setArg(0, cost_buffer);
   labels_kernel.setArg(1, msg_buffer);
   labels_kernel.setArg(2, static_cast<int>(n));
   labels_kernel.setArg(3, label_buffer);
-  queue.enqueueNDRangeKernel(labels_kernel, cl::NullRange, global, cl::NDRange(kLocalSize));
+  queue.enqueueNDRangeKernel(labels_kernel, cl::NullRange, global, cl::NDRange(kMrfLocalSize));
   if (icm_iterations > 0) {
     RunIcmOpenCL(context, cost_buffer, offset_buffer, right_buffer, down_buffer, problem,
                  icm_iterations, label_buffer);
   }
-  std::vector<int> labels(n);
-  queue.enqueueReadBuffer(label_buffer, CL_TRUE, 0, n * sizeof(int), labels.data());
-  return labels;
+  return MrfReadLabels(queue, label_buffer, n);
 }
 
 }  // namespace hairmvs

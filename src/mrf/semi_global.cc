@@ -220,25 +220,18 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
   cl::Kernel path_kernel(program, "sgm_path");
   cl::Kernel argmin_kernel(program, "sgm_argmin");
 
-  auto read_only = [&](const std::vector<float>& host) {
-    return cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, host.size() * sizeof(float),
-                      const_cast<float*>(host.data()));
-  };
-  cl::Buffer cost_buffer = read_only(problem.data_cost);
-  cl::Buffer offset_buffer = read_only(offset);
+  cl::Buffer cost_buffer = MrfReadOnlyBuffer(ctx, problem.data_cost);
+  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
   cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, n * num_labels * sizeof(float));
   cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
   queue.enqueueFillBuffer(sum_buffer, 0.0f, 0, n * num_labels * sizeof(float));
 
-  // Fixed local size (PoCL specialises kernels per local size), global size rounded up.
-  constexpr int kLocalSize = 16;
-  auto rounded = [](int count) { return (count + kLocalSize - 1) / kLocalSize * kLocalSize; };
   // Keep each direction's weight buffer alive until the queue has finished with it.
   std::vector<cl::Buffer> weight_buffers;
   for (const auto& dir : SemiGlobalDirections(num_directions)) {
     const int dx = dir[0];
     const int dy = dir[1];
-    weight_buffers.push_back(read_only(DirectionWeights(weights, dx, dy)));
+    weight_buffers.push_back(MrfReadOnlyBuffer(ctx, DirectionWeights(weights, dx, dy)));
     const int num_paths = NumPaths(width, height, dx, dy);
     path_kernel.setArg(0, cost_buffer);
     path_kernel.setArg(1, offset_buffer);
@@ -251,23 +244,21 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
     path_kernel.setArg(8, dy);
     path_kernel.setArg(9, num_paths);
     path_kernel.setArg(10, sum_buffer);
-    queue.enqueueNDRangeKernel(path_kernel, cl::NullRange, cl::NDRange(rounded(num_paths)),
-                               cl::NDRange(kLocalSize));
+    queue.enqueueNDRangeKernel(path_kernel, cl::NullRange, MrfGlobalRange(num_paths),
+                               cl::NDRange(kMrfLocalSize));
   }
   argmin_kernel.setArg(0, sum_buffer);
   argmin_kernel.setArg(1, static_cast<int>(n));
   argmin_kernel.setArg(2, label_buffer);
-  queue.enqueueNDRangeKernel(argmin_kernel, cl::NullRange,
-                             cl::NDRange(rounded(static_cast<int>(n))), cl::NDRange(kLocalSize));
+  queue.enqueueNDRangeKernel(argmin_kernel, cl::NullRange, MrfGlobalRange(n),
+                             cl::NDRange(kMrfLocalSize));
 
   if (icm_iterations > 0) {
     // weight_buffers[0], [2]: directions (1, 0) and (0, 1), i.e. weights.right and .down.
     RunIcmOpenCL(context, cost_buffer, offset_buffer, weight_buffers[0], weight_buffers[2],
                  problem, icm_iterations, label_buffer);
   }
-  std::vector<int> labels(n);
-  queue.enqueueReadBuffer(label_buffer, CL_TRUE, 0, n * sizeof(int), labels.data());
-  return labels;
+  return MrfReadLabels(queue, label_buffer, n);
 }
 
 }  // namespace hairmvs
