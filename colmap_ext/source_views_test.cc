@@ -11,18 +11,9 @@
 namespace hairmvs {
 namespace {
 
+using testing_util::ErrorOf;
 using testing_util::MakeTestDir;
 using testing_util::WriteTestWorkspace;
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 // Views with identity rotation at `centres` (camera y points down, so +y is "below"), named
 // by `names`; points on the plane z = 2; point k is seen by the views whose bit is set in

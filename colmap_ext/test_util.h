@@ -12,9 +12,21 @@
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
+#include "src/core/logging.h"
 
 namespace hairmvs {
 namespace testing_util {
+
+// The message of the hairmvs::Error that f() throws; "(no error)" when it throws none.
+template <typename F>
+std::string ErrorOf(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
 
 // A fresh, empty folder under the test temp dir.
 inline std::string MakeTestDir(const std::string& name) {

@@ -13,18 +13,9 @@ namespace hairmvs {
 namespace {
 
 using testing_util::MakePlaneModel;
+using testing_util::ErrorOf;
 using testing_util::MakeTestDir;
 using testing_util::WriteTestWorkspace;
-
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 TEST(Workspace, ReadsLayoutAndPaths) {
   const std::string dir = MakeTestDir("ws");
