@@ -43,6 +43,10 @@ struct OrientationStereoOptions {
   // Depth range from the sparse points inside the view's mask only (COLMAP's percentile rule
   // on them), so that a background room does not widen the range; all points without a mask.
   bool depth_range_from_mask = true;
+  // With masks: the depth range from the masks' visual hull (rays of the reference's masked
+  // pixels carved by the other views' masks), searched over [0.5 x, 2 x] COLMAP's range;
+  // the sparse rule when the hull gives none.
+  bool depth_range_from_visual_hull = true;
   DepthSampling depth_sampling = DepthSampling::kInverseDepth;
   // Labels over the full depth range (coarse stage).
   int num_depths = 64;
@@ -114,6 +118,8 @@ struct OrientationStereoOptions {
     v("depth_max", &depth_max, "depth range end in metres (<= 0: from the sparse points)");
     v("depth_range_from_mask", &depth_range_from_mask,
       "depth range from the sparse points inside the mask (COLMAP's rule on them)");
+    v("depth_range_from_visual_hull", &depth_range_from_visual_hull,
+      "with masks: depth range from the masks' visual hull (sparse rule as fallback)");
     v("depth_sampling", &depth_sampling, "depth|inverse_depth: label spacing");
     v("num_depths", &num_depths, "labels over the full depth range");
     v("num_levels", &num_levels, "orientation pyramid levels in the data term (paper: 3)");

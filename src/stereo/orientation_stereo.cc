@@ -26,6 +26,7 @@
 #include "src/opencl/opencl_context.h"
 #include "src/orientation/orientation_field.h"
 #include "src/stereo/depth_estimator.h"
+#include "src/stereo/depth_range.h"
 
 namespace hairmvs {
 
@@ -216,12 +217,10 @@ class ViewLoader {
     return ReadMask(workspace_.MaskPath(name), width, height);
   }
 
- private:
-  StereoViewData Read(const std::string& name) {
-    ScopedStageTimer timer(timings_, "orientation");
+  // The camera at the processing resolution.
+  StereoCamera ProcessingCamera(const std::string& name) const {
     const Camera& camera = workspace_.CameraOf(name);
     const Image& image = workspace_.ImageByName(name);
-    StereoViewData data;
     StereoCamera full;
     full.K = camera.CalibrationMatrix();
     full.R = image.R();
@@ -230,7 +229,33 @@ class ViewLoader {
     full.height = static_cast<int>(camera.height);
     int w, h;
     ProcessingSize(full.width, full.height, options_.max_image_size, &w, &h);
-    data.camera = full.Scaled(w, h);
+    return full.Scaled(w, h);
+  }
+
+  // Camera and mask at the processing resolution of every view that has a mask except
+  // `exclude`, for the visual hull depth range (masks read once, then cached).
+  std::vector<std::pair<StereoCamera, FloatMap>> MaskedViews(const std::string& exclude) {
+    if (masked_views_.empty()) {
+      for (const std::string& name : workspace_.ImageNames()) {
+        if (workspace_.MaskPath(name).empty()) continue;
+        const StereoCamera camera = ProcessingCamera(name);
+        masked_views_.emplace_back(
+            name, std::make_pair(camera, Mask(name, camera.width, camera.height)));
+      }
+    }
+    std::vector<std::pair<StereoCamera, FloatMap>> views;
+    for (const auto& [name, view] : masked_views_) {
+      if (name != exclude) views.push_back(view);
+    }
+    return views;
+  }
+
+ private:
+  StereoViewData Read(const std::string& name) {
+    ScopedStageTimer timer(timings_, "orientation");
+    StereoViewData data;
+    data.camera = ProcessingCamera(name);
+    const int w = data.camera.width, h = data.camera.height;
 
     // Expected level sizes.
     std::vector<std::array<int, 2>> sizes = {{w, h}};
@@ -290,6 +315,7 @@ class ViewLoader {
   StageTimings* timings_;
   std::unique_ptr<OrientationFieldComputer> computer_;
   std::list<std::pair<std::string, StereoViewData>> cache_;
+  std::vector<std::pair<std::string, std::pair<StereoCamera, FloatMap>>> masked_views_;
 };
 
 }  // namespace
@@ -344,6 +370,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const FloatMap mask =
         loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
     double depth_min = options.depth_min, depth_max = options.depth_max;
+    std::string range_source = "options";
     if (depth_min <= 0 || depth_max <= 0) {
       const uint32_t image_id = workspace.ImageByName(name).image_id;
       const DepthRange range = options.depth_range_from_mask
@@ -351,6 +378,19 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                    : ComputeDepthRange(workspace.Model(), image_id);
       if (depth_min <= 0) depth_min = range.min_m;
       if (depth_max <= 0) depth_max = range.max_m;
+      range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
+      // The masks' visual hull, searched over COLMAP's all-points range widened to
+      // [0.5 min, 2 max]: the sparse points of a textured room say little about the head.
+      const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
+      double hull_min = 0, hull_max = 0;
+      if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
+          wide.min_m > 0 && wide.max_m > wide.min_m &&
+          VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * wide.min_m,
+                               2 * wide.max_m, &hull_min, &hull_max)) {
+        if (options.depth_min <= 0) depth_min = hull_min;
+        if (options.depth_max <= 0) depth_max = hull_max;
+        range_source = "visual hull";
+      }
     }
     THROW_IF(!(depth_min > 0 && depth_max > depth_min),
              name << ": no depth range (too few sparse points seen by this view?); give "
@@ -371,10 +411,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       WriteDepthPng(depth_path + ".png", estimate.depth);
       WriteNormalPng(workspace.NormalMapPath(name, "geometric") + ".png", normals);
     }
-    std::printf("  %s: %d x %d, depth %.4f-%.4f m, %d sources, %d valid pixels, "
+    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources, %d valid pixels, "
                 "MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
-                depth_max, static_cast<int>(sources.size()), estimate.num_valid,
+                depth_max, range_source.c_str(), static_cast<int>(sources.size()),
+                estimate.num_valid,
                 estimate.coarse_energy, estimate.fine_energy);
     std::fflush(stdout);
     result.depth_map_paths.push_back(depth_path);

@@ -1,0 +1,41 @@
+#pragma once
+// Depth range of a reference view from the masks' visual hull: the depths along the rays of
+// the reference's masked pixels whose 3D points every other view that sees them keeps in its
+// mask. For hair captured in a textured room the sparse points (COLMAP's range rule) lie
+// mostly on the room, giving ranges several times deeper than the head; the hull is tight.
+
+#include <utility>
+#include <vector>
+
+#include "src/core/float_map.h"
+#include "src/stereo/stereo_geometry.h"
+
+namespace hairmvs {
+
+struct VisualHullRangeOptions {
+  // Reference pixels sampled: every pixel_step-th column and row inside the mask.
+  int pixel_step = 8;
+  // Depth samples per ray, uniform in inverse depth over the search range.
+  int num_samples = 256;
+  // Percentiles (0-100) of the kept depths that give the range (robust to stray samples).
+  double low_percentile = 1;
+  double high_percentile = 99;
+  // Each end widened by max(margin_fraction * (max - min), margin_m).
+  double margin_fraction = 0.05;
+  double margin_m = 0.005;
+  // A depth sample is kept only if at least this many other views see it inside their image
+  // (and all of those inside their mask): unconstrained samples say nothing about the hull.
+  int min_observing_views = 1;
+  // Fewer kept samples than this: no range (returns false).
+  int min_kept_samples = 20;
+};
+
+// Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
+// pixel convention. Returns false (outputs untouched) when too few samples are kept.
+bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
+                          const std::vector<std::pair<StereoCamera, FloatMap>>& others,
+                          double search_min_m, double search_max_m, double* min_m,
+                          double* max_m,
+                          const VisualHullRangeOptions& options = VisualHullRangeOptions());
+
+}  // namespace hairmvs
