@@ -44,6 +44,8 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                            &mask});
   }
 
+  const int min_observing =
+      std::min(options.min_observing_views, static_cast<int>(others.size()));
   const Eigen::Matrix3d K_inv = ref.K.inverse();
   std::vector<double> kept;
   for (int row = options.pixel_step / 2; row < ref.height; row += options.pixel_step) {
@@ -68,7 +70,7 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
             break;
           }
         }
-        if (!vetoed && observing >= options.min_observing_views) kept.push_back(depth);
+        if (!vetoed && observing >= std::max(1, min_observing)) kept.push_back(depth);
       }
     }
   }
