@@ -10,6 +10,8 @@ OUT=${1:-out/demo}
 HAIRMVS=./build/src/cli/hairmvs
 start=$(date +%s)
 rm -rf "$OUT"
-$HAIRMVS synthesize --output_path "$OUT"
+# Denser hair than the generator's quick default: sparse, see-through hair leaves the
+# sideways view pairs little orientation texture to match.
+$HAIRMVS synthesize --output_path "$OUT" --width 960 --num_strands 40000
 $HAIRMVS pipeline --workspace_path "$OUT/dense" --ground_truth_path "$OUT/gt"
 echo "demo: synthesis + pipeline + evaluation in $(( $(date +%s) - start )) s; outputs in $OUT/dense"
