@@ -2,7 +2,9 @@
 // COLMAP dense workspace; from a user's own photos, `colmap image_undistorter` first.
 
 #include <cstdio>
+#include <algorithm>
 #include <cstdlib>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -16,6 +18,8 @@
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
 #include "src/core/timer.h"
+#include "src/evaluation/depth_evaluation.h"
+#include "src/evaluation/ground_truth.h"
 #include "src/opencl/opencl_options.h"
 
 namespace hairmvs {
@@ -155,17 +159,26 @@ int RunPipeline(int argc, char** argv) {
     std::fprintf(stderr, "[pipeline] evaluation against %s\n", ground_truth_path.c_str());
     DepthEvaluationOptions depth_options;
     depth_options.image_names = image_names;
+    const MeshEvaluationOptions mesh_options;
+    // The true strands are indexed once for both evaluations (at the finer of the two spacings).
+    std::unique_ptr<StrandDistance> strands;
+    {
+      ScopedStageTimer timer(&timings, "index true strands");
+      strands = std::make_unique<StrandDistance>(
+          ReadGroundTruthStrands(ground_truth_path),
+          std::min(depth_options.strand_spacing_m, mesh_options.strand_spacing_m));
+    }
     {
       ScopedStageTimer timer(&timings, "evaluate_depth");
-      const DepthEvaluationResult depth = EvaluateDepthMaps(workspace_path, ground_truth_path,
-                                                            depth_options);
+      const DepthEvaluationResult depth =
+          EvaluateDepthMaps(workspace_path, ground_truth_path, depth_options, *strands);
       std::printf("%s\n", depth.Table().c_str());
     }
     const std::string mesh_path = JoinPaths(workspace_path, "meshed-hair.ply");
     if (ExistsFile(mesh_path)) {
       ScopedStageTimer timer(&timings, "evaluate_mesh");
       const MeshEvaluationResult mesh =
-          EvaluateMesh(mesh_path, ground_truth_path, workspace_path, MeshEvaluationOptions());
+          EvaluateMesh(mesh_path, ground_truth_path, workspace_path, mesh_options, *strands);
       std::printf("%s\n", mesh.Report().c_str());
     }
   }

@@ -1,5 +1,5 @@
 #pragma once
-// EvaluateDepthMaps with the true strands' index built by the caller (tests and tools that
+// EvaluateDepthMaps and EvaluateMesh with the true strands' index built by the caller (tests and tools that
 // evaluate several workspaces of one data set index the strands once: ~25 s for 40 000 strands
 // at 0.2 mm).
 
@@ -15,5 +15,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
                                         const DepthEvaluationOptions& options,
                                         const StrandDistance& strands);
+MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
+                                  const std::string& ground_truth_path,
+                                  const std::string& workspace_path,
+                                  const MeshEvaluationOptions& options,
+                                  const StrandDistance& strands);
 
 }  // namespace hairmvs

@@ -17,6 +17,7 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/timer.h"
+#include "src/evaluation/depth_evaluation.h"
 #include "src/evaluation/evaluation_util.h"
 #include "src/evaluation/ground_truth.h"
 #include "src/evaluation/mesh_distance.h"
@@ -78,6 +79,21 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const MeshEvaluationOptions& options) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  Timer timer;
+  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
+  const StrandDistance strand_distance(strands, options.strand_spacing_m);
+  LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
+            << timer.ElapsedSeconds() << " s)";
+  return EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, strand_distance);
+}
+
+MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
+                                  const std::string& ground_truth_path,
+                                  const std::string& workspace_path,
+                                  const MeshEvaluationOptions& options,
+                                  const StrandDistance& strand_distance) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
   const TriangleMesh mesh = ReadMeshPly(mesh_path);
   THROW_IF(mesh.vertices.empty() || mesh.faces.empty(),
            mesh_path << ": the mesh has " << mesh.vertices.size() << " vertices and "
@@ -88,11 +104,6 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   std::mt19937 rng(options.seed);
 
   // Accuracy: mesh to the true strands.
-  Timer timer;
-  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
-  const StrandDistance strand_distance(strands, options.strand_spacing_m);
-  LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
-            << timer.ElapsedSeconds() << " s)";
   std::vector<Eigen::Vector3d> vertices;
   for (const Eigen::Vector3f& v : mesh.vertices) vertices.push_back(v.cast<double>());
   result.accuracy_vertices = SummarizeDistances(strand_distance.Distances(vertices));
