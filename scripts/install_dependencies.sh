@@ -34,4 +34,5 @@ SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive
 $SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+# Recommends included: the build was proven with them (Open3D was installed that way).
+$SUDO apt-get install -y -qq "${missing[@]}"
