@@ -16,6 +16,9 @@
 
 namespace hairmvs {
 
+// Which source views each reference uses (colmap_ext/source_views.h: --SourceViews.*).
+struct SourceViewOptions;
+
 // What is matched between views.
 enum class StereoCost {
   kOrientation,  // paper Eq. 5: -Re(O_ref* O_v exp(2i(phi_ref - phi_v)))
@@ -34,9 +37,6 @@ struct OrientationStereoOptions {
   // Processing resolution: the longer image side is downscaled to at most this (-1: full size).
   // Depth maps are then smaller than the images, as COLMAP's are.
   int max_image_size = -1;
-  // Source views per reference (stereo/patch-match.cfg and SelectSourceViews decide which).
-  int max_num_source_views = 4;
-  double min_triangulation_angle_deg = 1.0;
   // Depth range override in metres (<= 0: ComputeDepthRange, COLMAP's rule from sparse points).
   double depth_min = -1;
   double depth_max = -1;
@@ -111,9 +111,6 @@ struct OrientationStereoOptions {
   void ForEachField(Visitor&& v) {
     v("cost", &cost, "orientation|photometric: what is matched");
     v("max_image_size", &max_image_size, "longer side of the processing resolution (-1: full)");
-    v("max_num_source_views", &max_num_source_views, "source views per reference");
-    v("min_triangulation_angle_deg", &min_triangulation_angle_deg,
-      "source views must see the scene under at least this angle");
     v("depth_min", &depth_min, "depth range start in metres (<= 0: from the sparse points)");
     v("depth_max", &depth_max, "depth range end in metres (<= 0: from the sparse points)");
     v("depth_range_from_mask", &depth_range_from_mask,
@@ -169,11 +166,14 @@ struct OrientationStereoResult {
 
 // Computes depth maps for `image_names` (empty: every image of the workspace). `device_spec`
 // picks the OpenCL device ("" = first GPU, else first CPU; an index; or a name substring).
+// `source_views` chooses the source views (null: SourceViewOptions' defaults, 4 views); an
+// explicit patch-match.cfg list is capped to its max_num_source_views.
 // Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const std::vector<std::string>& image_names,
                                              const OrientationStereoOptions& options,
                                              StageTimings* timings,
-                                             const std::string& device_spec = "");
+                                             const std::string& device_spec = "",
+                                             const SourceViewOptions* source_views = nullptr);
 
 }  // namespace hairmvs

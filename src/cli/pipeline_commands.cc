@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "colmap_ext/source_views.h"
 #include "hairmvs/evaluation.h"
 #include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
@@ -72,6 +73,7 @@ int RunPipeline(int argc, char** argv) {
   OpenCLOptions opencl_options;
   OrientationFieldOptions orientation_options;
   OrientationStereoOptions stereo_options;
+  SourceViewOptions source_options;
   TemplateFusionOptions fusion_options;
 
   OptionParser parser("pipeline",
@@ -93,6 +95,7 @@ int RunPipeline(int argc, char** argv) {
   parser.AddSection("OpenCL", &opencl_options);
   parser.AddSection("OrientationField", &orientation_options);
   parser.AddSection("OrientationStereo", &stereo_options);
+  parser.AddSection("SourceViews", &source_options);
   parser.AddSection("TemplateFusion", &fusion_options);
   if (!parser.Parse(argc, argv)) return 0;
 
@@ -138,7 +141,8 @@ int RunPipeline(int argc, char** argv) {
     announce("orientation stereo");
     stereo_options.write_png = stereo_options.write_png || write_png;
     const OrientationStereoResult result = RunOrientationStereo(
-        workspace_path, image_names, stereo_options, &timings, opencl_options.device);
+        workspace_path, image_names, stereo_options, &timings, opencl_options.device,
+        &source_options);
     std::printf("%s\n", result.BriefReport().c_str());
   }
   if (HasStage(stages, "fusion")) {

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "colmap_ext/source_views.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/cli/command_registry.h"
 #include "src/core/logging.h"
@@ -25,6 +26,7 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   std::vector<std::string> image_names;
   bool write_png = false;
   OrientationStereoOptions options;
+  SourceViewOptions source_options;
   OpenCLOptions opencl_options;
   OptionParser parser("orientation_stereo",
                       "Depth maps of a COLMAP dense workspace from orientation fields (Luo et al. "
@@ -36,6 +38,7 @@ int RunOrientationStereoCommand(int argc, char** argv) {
              "between processes");
   parser.Add("write_png", &write_png, "also write coloured depth and normal pictures");
   parser.AddSection("OrientationStereo", &options);
+  parser.AddSection("SourceViews", &source_options);
   parser.AddSection("OpenCL", &opencl_options);
   if (!parser.Parse(argc, argv)) return 0;
   if (parser.WasGiven("write_png")) options.write_png = write_png;
@@ -44,7 +47,7 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   std::printf("%s", parser.Values().c_str());
   StageTimings timings;
   const OrientationStereoResult result = RunOrientationStereo(
-      workspace_path, image_names, options, &timings, opencl_options.device);
+      workspace_path, image_names, options, &timings, opencl_options.device, &source_options);
   PrintSummary(result, timings);
   return 0;
 }
@@ -59,6 +62,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   double depth_min = -1, depth_max = -1, min_triangulation_angle = 1.0;
   bool geom_consistency = true, filter = true;
   OrientationStereoOptions options;
+  SourceViewOptions source_options;
   OpenCLOptions opencl_options;
   OptionParser parser("patch_match_stereo",
                       "Drop-in for `colmap patch_match_stereo`: orientation-field depth maps in "
@@ -76,7 +80,10 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              "accepted; hairmvs always writes the .geometric maps that stereo_fusion reads");
   parser.Add("PatchMatchStereo.filter", &filter,
              "drop low-confidence pixels and pixels at the ends of the depth range");
+  parser.Add("config_path", &config_path,
+             "patch-match.cfg to use instead of stereo/patch-match.cfg (as colmap's)");
   parser.AddSection("OrientationStereo", &options);
+  parser.AddSection("SourceViews", &source_options);
   parser.AddSection("OpenCL", &opencl_options);
   const std::string kPatchMatchOnly = "PatchMatch-specific; orientation stereo has no such setting";
   for (const char* name :
@@ -96,15 +103,15 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   parser.AddIgnored("PatchMatchStereo.cache_size", "views are cached by count, not size");
   parser.AddIgnored("PatchMatchStereo.allow_missing_files", "missing files are errors here");
   parser.AddIgnored("pmvs_option_name", "only --workspace_format COLMAP is supported");
-  parser.AddIgnored("config_path", "stereo/patch-match.cfg of the workspace is used");
   if (!parser.Parse(argc, argv)) return 0;
   THROW_IF(workspace_format != "COLMAP",
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
+  if (parser.WasGiven("config_path")) source_options.config_path = config_path;
   if (parser.WasGiven("PatchMatchStereo.max_image_size")) options.max_image_size = max_image_size;
   if (parser.WasGiven("PatchMatchStereo.depth_min")) options.depth_min = depth_min;
   if (parser.WasGiven("PatchMatchStereo.depth_max")) options.depth_max = depth_max;
   if (parser.WasGiven("PatchMatchStereo.min_triangulation_angle")) {
-    options.min_triangulation_angle_deg = min_triangulation_angle;
+    source_options.min_triangulation_angle_deg = min_triangulation_angle;
   }
   if (!filter) {
     options.filter_range_ends = false;
@@ -114,7 +121,8 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);
   StageTimings timings;
   const OrientationStereoResult result =
-      RunOrientationStereo(workspace_path, {}, options, &timings, opencl_options.device);
+      RunOrientationStereo(workspace_path, {}, options, &timings, opencl_options.device,
+                           &source_options);
   PrintSummary(result, timings);
   return 0;
 }

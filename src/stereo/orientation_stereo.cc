@@ -68,7 +68,6 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   std::ostringstream e;
   MrfSolverType solver;
   if (max_image_size == 0 || max_image_size < -1) e << "max_image_size must be > 0 or -1; ";
-  if (max_num_source_views < 1) e << "max_num_source_views must be >= 1; ";
   if (depth_min > 0 && depth_max > 0 && depth_max <= depth_min) {
     e << "depth_max must exceed depth_min; ";
   }
@@ -324,7 +323,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const std::vector<std::string>& image_names,
                                              const OrientationStereoOptions& options,
                                              StageTimings* timings,
-                                             const std::string& device_spec) {
+                                             const std::string& device_spec,
+                                             const SourceViewOptions* source_views) {
   Timer total_timer;
   std::string error;
   THROW_IF(!options.Check(&error), "invalid --OrientationStereo options: " << error);
@@ -334,9 +334,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
 
-  SourceViewOptions source_options;
-  source_options.max_num_source_views = options.max_num_source_views;
-  source_options.min_triangulation_angle_deg = options.min_triangulation_angle_deg;
+  const SourceViewOptions source_options =
+      source_views != nullptr ? *source_views : SourceViewOptions();
+  THROW_IF(!source_options.Check(&error), "invalid --SourceViews options: " << error);
   std::map<std::string, std::vector<std::string>> sources_of;
   for (const SourceViewSelection& selection : SelectSourceViews(workspace, source_options)) {
     sources_of[selection.reference] = selection.sources;
@@ -357,8 +357,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     progress.Stage("orientation fields");
     std::vector<std::string> source_names = it->second;
-    if (static_cast<int>(source_names.size()) > options.max_num_source_views) {
-      source_names.resize(options.max_num_source_views);
+    if (static_cast<int>(source_names.size()) > source_options.max_num_source_views) {
+      source_names.resize(source_options.max_num_source_views);
     }
     // Copies: the cache may evict while loading the sources.
     const StereoViewData ref = loader.Load(name);
