@@ -74,8 +74,11 @@ struct DepthEvaluationOptions {
   // 3D accuracy from at most this many randomly chosen pixels per view (0 = all).
   int max_points_3d_per_view = 0;
   int seed = 0;
-  // Spline sampling of the true strands (StrandDistance).
-  double strand_spacing_m = 2e-4;
+  // Spline sampling of the true strands (StrandDistance): distances are to the polyline through
+  // the samples, within spacing^2 / (8 x radius of curvature) of the spline: 1 mm gives < 0.03
+  // mm for curls of 4 mm radius (~6 mm radius of curvature) and 5x fewer samples than 0.2 mm
+  // (100 000 curly strands: index built in 8 s instead of 39 s, 3.7 GB -> ~0.9 GB).
+  double strand_spacing_m = 1e-3;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -130,7 +133,7 @@ struct MeshEvaluationOptions {
   // True visible hair surface: hair pixels of every view, at most this many (random).
   int max_ground_truth_points = 300000;
   int seed = 0;
-  double strand_spacing_m = 2e-4;
+  double strand_spacing_m = 1e-3;  // as EvaluateDepthOptions::strand_spacing_m
   // JSON summary; empty = <workspace>/stereo/evaluation/mesh_evaluation.json when a workspace
   // is given, else <mesh>.evaluation.json.
   std::string output_json;

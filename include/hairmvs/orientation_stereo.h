@@ -32,6 +32,15 @@ enum class DepthSampling { kDepth, kInverseDepth };
 std::string ToString(DepthSampling sampling);
 bool FromString(const std::string& text, DepthSampling* sampling);
 
+// How the per-pixel visual hull depth bound is used (with masks).
+enum class VisualHullBound {
+  kOff,
+  kPenalty,  // labels in front of the bound get a penalty in the data term
+  kFilter,   // depths that end in front of the bound are invalid (0)
+};
+std::string ToString(VisualHullBound bound);
+bool FromString(const std::string& text, VisualHullBound* bound);
+
 struct OrientationStereoOptions {
   StereoCost cost = StereoCost::kOrientation;
   // Processing resolution: the longer image side is downscaled to at most this (-1: full size).
@@ -47,9 +56,23 @@ struct OrientationStereoOptions {
   // pixels carved by the other views' masks), searched over [0.5 x, 2 x] COLMAP's range;
   // the sparse rule when the hull gives none.
   bool depth_range_from_visual_hull = true;
+  // With masks: whatever a pixel sees lies inside every mask that sees it, so not in front of
+  // where its ray enters the masks' visual hull (less the tolerance). kPenalty: labels in front
+  // of the bound get the pixel's worst cost plus a slope towards the bound. kFilter: depths
+  // that end in front of it are dropped. Where the data term's minimum lies in front of the
+  // hull (see-through hair), the penalty pushes the depth to the next minimum, often far behind
+  // (synth_straight_gantry g5_r: per-pixel median 10.4 -> 23.9 mm), while filtering drops it.
+  VisualHullBound visual_hull_depth_bound = VisualHullBound::kFilter;
+  double visual_hull_tolerance_m = 0.002;
+  // The other views' masks are dilated by this many pixels before carving the hull (range and
+  // bound), so that mask edges and calibration errors of a pixel or two do not carve hair.
+  int visual_hull_mask_dilation_px = 2;
   DepthSampling depth_sampling = DepthSampling::kInverseDepth;
-  // Labels over the full depth range (coarse stage).
-  int num_depths = 64;
+  // Labels over the full depth range (coarse stage). 128 rather than 64, with lambda and the
+  // truncation rescaled so that the smoothness per metre is unchanged: synth_straight_gantry
+  // g0_c, g2_c, g4_c, g5_r per-pixel median 6.12 -> 5.87 mm; a synthesised curly T group
+  // (100k strands, 960 px) 3.41 -> 2.94 mm.
+  int num_depths = 128;
   // Orientation pyramid levels used by the data term (paper: 3).
   int num_levels = 3;
   // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
@@ -66,10 +89,11 @@ struct OrientationStereoOptions {
   // the normalised fields, on synth_straight_gantry g0_c + g0_l: 0.02 / 0.1 / 0.5 / 2 gave
   // per-pixel medians of 9.1 / 7.2 / 6.1 / 6.4 mm. (With the raw fields, whose costs are about
   // 100x smaller, 0.002 was best: 0.0005 / 0.002 / 0.008 / 0.05 gave 38 / 15 / 32 / 56 mm.)
-  double lambda = 0.5;
+  // Measured with 64 labels (lambda 0.5 there; 0.125 with 128 labels is the same per metre).
+  double lambda = 0.125;
   // Truncation of the squared label difference of the smoothness term, in coarse labels
-  // (<= 0: plain quadratic, as the paper).
-  double truncation_labels = 4;
+  // (<= 0: plain quadratic, as the paper). 8 coarse labels of 128: 4 of 64.
+  double truncation_labels = 8;
   // MRF solver, by name (graph_cuts, semi_global, ... as src/mrf offers). semi_global: graph
   // cuts took 445 s for the coarse stage of a 960 x 640 view (128 labels), semi-global 118 s.
   std::string mrf_solver = "semi_global";
@@ -102,6 +126,21 @@ struct OrientationStereoOptions {
   double orientation_normalization_eps = 1e-3;
   // Photometric cost only: NCC window (px) at every level.
   int ncc_window_px = 7;
+  // Geometric consistency, as COLMAP's patch_match_stereo names its passes: each view's depth
+  // map as estimated is written as depth_maps/<name>.photometric.bin; the .geometric.bin map
+  // keeps the pixels that at least geom_consistency_min_views of its source views agree with
+  // (forward-backward reprojection error within geom_consistency_max_error_px, COLMAP's
+  // filter_geom_consistency_max_cost; src/stereo/consistency_filter.h).
+  // Sources without a .photometric map yet (a job array's other jobs) are skipped; run again
+  // with geom_consistency_only once all jobs are done. Off: .geometric.bin is the estimate.
+  bool geom_consistency = true;
+  double geom_consistency_max_error_px = 3.0;
+  int geom_consistency_min_views = 1;
+  // 3 px rather than COLMAP's 1: on synthesised curly T groups (seeds 1, 2) 1 / 2 / 3 px kept
+  // 83 / 90 / 93% of the hair pixels at per-pixel medians of 2.47 / 2.69 / 2.81 mm (seed 2),
+  // and the hair's own depth texture is a few pixels of disparity deep.
+  // Only the consistency pass, on the existing .photometric maps (no estimation).
+  bool geom_consistency_only = false;
   // Reuse / write stereo/orientation_maps/<name>.l<k>.bin.
   bool reuse_orientation_maps = true;
   bool write_orientation_maps = true;
@@ -117,6 +156,12 @@ struct OrientationStereoOptions {
       "depth range from the sparse points inside the mask (COLMAP's rule on them)");
     v("depth_range_from_visual_hull", &depth_range_from_visual_hull,
       "with masks: depth range from the masks' visual hull (sparse rule as fallback)");
+    v("visual_hull_depth_bound", &visual_hull_depth_bound,
+      "off|penalty|filter: with masks, no depth in front of where the ray enters the hull");
+    v("visual_hull_tolerance_m", &visual_hull_tolerance_m,
+      "tolerance of the visual hull depth bound in metres");
+    v("visual_hull_mask_dilation_px", &visual_hull_mask_dilation_px,
+      "dilate the other views' masks by this many px before carving the hull");
     v("depth_sampling", &depth_sampling, "depth|inverse_depth: label spacing");
     v("num_depths", &num_depths, "labels over the full depth range");
     v("num_levels", &num_levels, "orientation pyramid levels in the data term (paper: 3)");
@@ -145,6 +190,14 @@ struct OrientationStereoOptions {
     v("orientation_normalization_eps", &orientation_normalization_eps,
       "regulariser of the local variance in the normalisation");
     v("ncc_window_px", &ncc_window_px, "photometric cost: NCC window in px");
+    v("geom_consistency", &geom_consistency,
+      "write .photometric (as estimated) and .geometric (consistency-filtered) maps");
+    v("geom_consistency_max_error_px", &geom_consistency_max_error_px,
+      "consistency: largest forward-backward reprojection error in px");
+    v("geom_consistency_min_views", &geom_consistency_min_views,
+      "consistency: source views that must agree for a pixel to keep its depth");
+    v("geom_consistency_only", &geom_consistency_only,
+      "only run the consistency pass on existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,
       "read stereo/orientation_maps/*.l<k>.bin when present and of the right size");
     v("write_orientation_maps", &write_orientation_maps,

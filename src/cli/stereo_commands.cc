@@ -61,6 +61,8 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   int max_image_size = -1;
   double depth_min = -1, depth_max = -1, min_triangulation_angle = 1.0;
   bool geom_consistency = true, filter = true;
+  int filter_min_num_consistent = 1;
+  double filter_geom_consistency_max_cost = 3.0;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
   OpenCLOptions opencl_options;
@@ -77,7 +79,13 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   parser.Add("PatchMatchStereo.min_triangulation_angle", &min_triangulation_angle,
              "source views: minimum triangulation angle in degrees");
   parser.Add("PatchMatchStereo.geom_consistency", &geom_consistency,
-             "accepted; hairmvs always writes the .geometric maps that stereo_fusion reads");
+             "write .photometric maps, then .geometric maps filtered by consistency with the "
+             "source views (0: the .geometric maps are unfiltered)");
+  parser.Add("PatchMatchStereo.filter_min_num_consistent", &filter_min_num_consistent,
+             "source views that must agree for a pixel to keep its depth");
+  parser.Add("PatchMatchStereo.filter_geom_consistency_max_cost",
+             &filter_geom_consistency_max_cost,
+             "largest forward-backward reprojection error in px for a view to agree");
   parser.Add("PatchMatchStereo.filter", &filter,
              "drop low-confidence pixels and pixels at the ends of the depth range");
   parser.Add("config_path", &config_path,
@@ -94,8 +102,6 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
         "PatchMatchStereo.geom_consistency_regularizer",
         "PatchMatchStereo.geom_consistency_max_cost", "PatchMatchStereo.filter_min_ncc",
         "PatchMatchStereo.filter_min_triangulation_angle",
-        "PatchMatchStereo.filter_min_num_consistent",
-        "PatchMatchStereo.filter_geom_consistency_max_cost",
         "PatchMatchStereo.write_consistency_graph"}) {
     parser.AddIgnored(name, kPatchMatchOnly);
   }
@@ -113,7 +119,17 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   if (parser.WasGiven("PatchMatchStereo.min_triangulation_angle")) {
     source_options.min_triangulation_angle_deg = min_triangulation_angle;
   }
+  if (parser.WasGiven("PatchMatchStereo.geom_consistency")) {
+    options.geom_consistency = geom_consistency;
+  }
+  if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent")) {
+    options.geom_consistency_min_views = filter_min_num_consistent;
+  }
+  if (parser.WasGiven("PatchMatchStereo.filter_geom_consistency_max_cost")) {
+    options.geom_consistency_max_error_px = filter_geom_consistency_max_cost;
+  }
   if (!filter) {
+    options.geom_consistency = false;
     options.filter_range_ends = false;
     options.min_confidence = -std::numeric_limits<double>::infinity();
   }

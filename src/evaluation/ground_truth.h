@@ -66,11 +66,11 @@ Eigen::Vector3d CatmullRom(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
 // Cycles and Blender do), whose points are ~6 mm apart: each spline segment is sampled so
 // consecutive samples are at most max_spacing_m apart, the samples go into a KD-tree
 // (nanoflann), and the distance is the exact distance to the polyline through the samples
-// (within ~ spacing^2 / (8 * radius of curvature) of the spline: < 1 um for hair). Thread-safe
-// queries. Memory: ~30 bytes per sample (40 000 strands of 20 cm at 0.2 mm: ~1.2 GB).
+// (within ~ spacing^2 / (8 * radius of curvature) of the spline). Thread-safe queries.
+// Memory: ~30 bytes per sample (40 000 strands of 20 cm at 0.2 mm: ~1.2 GB).
 class StrandDistance {
  public:
-  explicit StrandDistance(const GroundTruthStrands& strands, double max_spacing_m = 2e-4);
+  explicit StrandDistance(const GroundTruthStrands& strands, double max_spacing_m = 1e-3);
   ~StrandDistance();
 
   double Distance(const Eigen::Vector3d& x) const;

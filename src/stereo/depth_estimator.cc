@@ -97,6 +97,32 @@ void BoxSums(const float* in, int width, int height, int radius, std::vector<dou
   }
 }
 
+// Labels v = base(p) + k * step in front of the pixel's bound label get the pixel's worst cost
+// plus its cost range per label of excess, so that the MRF is pulled back behind the bound even
+// where a whole band lies in front of it. bound_label: per pixel, -inf = none.
+void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
+                            const std::vector<float>& base, float step, int num_labels,
+                            std::vector<float>* volume) {
+  const size_t n = bound_label.size();
+  for (size_t p = 0; p < n; ++p) {
+    const float bound = bound_label[p];
+    if (!std::isfinite(bound)) continue;
+    const float base_p = base.empty() ? 0.0f : base[p];
+    if (base_p >= bound) continue;
+    float best = std::numeric_limits<float>::infinity(), worst = -best;
+    for (int k = 0; k < num_labels; ++k) {
+      const float c = (*volume)[k * n + p];
+      best = std::min(best, c);
+      worst = std::max(worst, c);
+    }
+    const float range = std::max(worst - best, 1e-6f);
+    for (int k = 0; k < num_labels; ++k) {
+      const float v = base_p + k * step;
+      if (v < bound) (*volume)[k * n + p] = worst + range * (bound - v);
+    }
+  }
+}
+
 }  // namespace
 
 FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps) {
@@ -130,7 +156,8 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
 
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
                                const std::vector<const StereoViewData*>& sources,
-                               const FloatMap& mask, const DepthLabels& labels,
+                               const FloatMap& mask, const FloatMap& depth_lower_bound,
+                               const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
                                Progress* progress) {
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
@@ -249,6 +276,34 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     zero_base[l].assign(static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
   }
   std::vector<float> coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
+  // The depth lower bound as labels, on the level-0 grid and (the smallest bound of each
+  // block, so that it never excludes what a finer pixel allows) on the coarse grid.
+  std::vector<float> bound0, bound_coarse;
+  if (!depth_lower_bound.Empty()) {
+    CHECK_EQ(depth_lower_bound.Width(), width0);
+    CHECK_EQ(depth_lower_bound.Height(), height0);
+    const float none = -std::numeric_limits<float>::infinity();
+    bound0.assign(static_cast<size_t>(width0) * height0, none);
+    for (size_t p = 0; p < bound0.size(); ++p) {
+      const float d = depth_lower_bound.Data()[p];
+      if (d > 0) bound0[p] = static_cast<float>(labels.Label(d));
+    }
+    const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+    const int factor = 1 << coarse_level;
+    bound_coarse.assign(static_cast<size_t>(cw) * ch, none);
+    for (int row = 0; row < height0; ++row) {
+      for (int col = 0; col < width0; ++col) {
+        const float b = bound0[row * width0 + col];
+        const int r = std::min(row / factor, ch - 1), c = std::min(col / factor, cw - 1);
+        float& coarse = bound_coarse[r * cw + c];
+        if (std::isfinite(b) && (!std::isfinite(coarse) || b < coarse)) coarse = b;
+      }
+    }
+  }
+  const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;
+  if (penalize && !bound_coarse.empty()) {
+    PenalizeInFrontOfBound(bound_coarse, {}, 1.0f, num_depths, &coarse_volume);
+  }
   if (progress != nullptr) progress->Stage("MRF (all depths)");
   const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
   const int coarse_pixels = cw * ch;
@@ -299,6 +354,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     }
     if (progress != nullptr) progress->Stage("cost volume and aggregation (fine band)");
     std::vector<float> fine_volume = build_volume(0, band, base, step);
+    if (penalize && !bound0.empty()) {
+      PenalizeInFrontOfBound(bound0, base[0], step, band, &fine_volume);
+    }
     if (progress != nullptr) progress->Stage("MRF (fine band)");
     const std::vector<int> fine_labels =
         solve(0, band, &fine_volume, base[0], step, &estimate.fine_energy);
@@ -333,6 +391,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     const float v = value.Data()[p];
     bool valid = mask0.Data()[p] > 0.5f && depth.Data()[p] > 0;
     if (options.filter_range_ends && (v < 0.5f || v > num_depths - 1.5f)) valid = false;
+    if (!penalize && !bound0.empty() && v < bound0[p]) valid = false;
     if (estimate.confidence.Data()[p] < options.min_confidence) valid = false;
     if (!valid) depth.Data()[p] = 0.0f;
     if (valid) ++estimate.num_valid;

@@ -41,9 +41,12 @@ struct DepthEstimate {
   int num_valid = 0;
 };
 
+// `depth_lower_bound` (level-0 grid, metres, 0 = none; may be empty): labels in front of it get
+// the pixel's worst cost plus one cost range per label of excess, in both stages.
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
                                const std::vector<const StereoViewData*>& sources,
-                               const FloatMap& mask, const DepthLabels& labels,
+                               const FloatMap& mask, const FloatMap& depth_lower_bound,
+                               const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
                                Progress* progress = nullptr);
 

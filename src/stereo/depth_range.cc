@@ -8,80 +8,124 @@
 
 namespace hairmvs {
 
-bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
-                          const std::vector<std::pair<StereoCamera, FloatMap>>& others,
-                          double search_min_m, double search_max_m, double* min_m,
-                          double* max_m, const VisualHullRangeOptions& options) {
+namespace {
+
+// Reference camera coordinates to another view's homogeneous pixel coordinates:
+// u = K_o (R_o R_r^T (X_r - t_r) + t_o) = A X_r + c.
+struct Projection {
+  Eigen::Matrix3d A;
+  Eigen::Vector3d c;
+  const StereoCamera* camera;
+  const FloatMap* mask;
+};
+
+// Whether the point X (reference camera frame) is inside the hull: seen inside the image by at
+// least `min_observing` views and inside the mask of every view that sees it.
+bool InsideHull(const std::vector<Projection>& projections, int min_observing,
+                const Eigen::Vector3d& X) {
+  int observing = 0;
+  for (const Projection& p : projections) {
+    const Eigen::Vector3d u = p.A * X + p.c;
+    if (!(u.z() > 0)) continue;  // behind the view: it cannot see the point
+    const double x = u.x() / u.z(), y = u.y() / u.z();
+    if (!(x >= 0 && y >= 0 && x < p.camera->width && y < p.camera->height)) continue;
+    ++observing;
+    const int c = std::min(static_cast<int>(x), p.camera->width - 1);
+    const int r = std::min(static_cast<int>(y), p.camera->height - 1);
+    if (!(p.mask->At(r, c) > 0.5f)) return false;
+  }
+  return observing >= std::max(1, min_observing);
+}
+
+}  // namespace
+
+FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
+                             const std::vector<std::pair<StereoCamera, FloatMap>>& others,
+                             double search_min_m, double search_max_m, int pixel_step,
+                             const VisualHullRangeOptions& options) {
   CHECK_EQ(ref_mask.Width(), ref.width);
   CHECK_EQ(ref_mask.Height(), ref.height);
-  CHECK_GT(options.pixel_step, 0);
+  CHECK_GT(pixel_step, 0);
   CHECK_GE(options.num_samples, 2);
-  if (!(search_min_m > 0 && search_max_m > search_min_m)) return false;
+  FloatMap intervals(ref.width, ref.height, 2, 0.0f);
+  if (!(search_min_m > 0 && search_max_m > search_min_m)) return intervals;
+  std::vector<Projection> projections;
   for (const auto& [camera, mask] : others) {
     CHECK_EQ(mask.Width(), camera.width);
     CHECK_EQ(mask.Height(), camera.height);
-  }
-
-  // Samples uniform in inverse depth: equal steps in disparity.
-  std::vector<double> depths(options.num_samples);
-  const double inv_near = 1.0 / search_min_m, inv_far = 1.0 / search_max_m;
-  for (int k = 0; k < options.num_samples; ++k) {
-    depths[k] = 1.0 / (inv_near + (inv_far - inv_near) * k / (options.num_samples - 1));
-  }
-
-  // Reference camera coordinates to each other view's homogeneous pixel coordinates:
-  // u = K_o (R_o R_r^T (X_r - t_r) + t_o) = A X_r + c.
-  struct Projection {
-    Eigen::Matrix3d A;
-    Eigen::Vector3d c;
-    const StereoCamera* camera;
-    const FloatMap* mask;
-  };
-  std::vector<Projection> projections;
-  for (const auto& [camera, mask] : others) {
     const Eigen::Matrix3d R_rel = camera.R * ref.R.transpose();
     projections.push_back({camera.K * R_rel, camera.K * (camera.t - R_rel * ref.t), &camera,
                            &mask});
   }
-
   const int min_observing =
       std::min(options.min_observing_views, static_cast<int>(others.size()));
+  // Samples uniform in inverse depth (equal steps in disparity), near to far.
+  const double inv_near = 1.0 / search_min_m, inv_far = 1.0 / search_max_m;
+  const int n = options.num_samples;
+  auto inverse_depth = [&](double k) { return inv_near + (inv_far - inv_near) * k / (n - 1); };
   const Eigen::Matrix3d K_inv = ref.K.inverse();
-  std::vector<double> kept;
-  for (int row = options.pixel_step / 2; row < ref.height; row += options.pixel_step) {
-    for (int col = options.pixel_step / 2; col < ref.width; col += options.pixel_step) {
+  const int first = pixel_step / 2;
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int row = first; row < ref.height; row += pixel_step) {
+    for (int col = first; col < ref.width; col += pixel_step) {
       if (!(ref_mask.At(row, col) > 0.5f)) continue;
       // SfM convention: pixel (col, row) is centred at image point (col + 0.5, row + 0.5).
       const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
-      for (const double depth : depths) {
-        const Eigen::Vector3d X = depth * ray;  // z-depth: ray has z = 1
-        int observing = 0;
-        bool vetoed = false;
-        for (const Projection& p : projections) {
-          const Eigen::Vector3d u = p.A * X + p.c;
-          if (!(u.z() > 0)) continue;  // behind the view: it cannot see the point
-          const double x = u.x() / u.z(), y = u.y() / u.z();
-          if (!(x >= 0 && y >= 0 && x < p.camera->width && y < p.camera->height)) continue;
-          ++observing;
-          const int c = std::min(static_cast<int>(x), p.camera->width - 1);
-          const int r = std::min(static_cast<int>(y), p.camera->height - 1);
-          if (!(p.mask->At(r, c) > 0.5f)) {
-            vetoed = true;
-            break;
-          }
-        }
-        if (!vetoed && observing >= std::max(1, min_observing)) kept.push_back(depth);
+      // z-depth: the ray has z = 1.
+      auto inside = [&](double k) {
+        return InsideHull(projections, min_observing, ray / inverse_depth(k));
+      };
+      int entry = -1;
+      for (int k = 0; k < n && entry < 0; ++k) {
+        if (inside(k)) entry = k;
       }
+      if (entry < 0) continue;
+      int exit = n;  // first sample outside after the entry
+      for (int k = entry + 1; k < n; ++k) {
+        if (!inside(k)) {
+          exit = k;
+          break;
+        }
+      }
+      // Bisection of the transitions (outside, inside] and (inside, outside].
+      auto refine = [&](double outside_k, double inside_k) {
+        for (int i = 0; i < 8; ++i) {
+          const double mid = 0.5 * (outside_k + inside_k);
+          (inside(mid) ? inside_k : outside_k) = mid;
+        }
+        return inside_k;
+      };
+      const double near_k = entry > 0 ? refine(entry - 1, entry) : entry;
+      const double far_k = exit < n ? refine(exit, exit - 1) : n - 1;
+      intervals.At(row, col, 0) = static_cast<float>(1.0 / inverse_depth(near_k));
+      intervals.At(row, col, 1) = static_cast<float>(1.0 / inverse_depth(far_k));
     }
   }
-  if (static_cast<int>(kept.size()) < std::max(1, options.min_kept_samples)) return false;
-  std::sort(kept.begin(), kept.end());
-  const auto at = [&](double percentile) {
-    const double p = std::clamp(percentile, 0.0, 100.0) / 100.0;
-    const size_t i = std::min(kept.size() - 1, static_cast<size_t>(p * (kept.size() - 1)));
-    return kept[i];
+  return intervals;
+}
+
+bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
+                          const std::vector<std::pair<StereoCamera, FloatMap>>& others,
+                          double search_min_m, double search_max_m, double* min_m,
+                          double* max_m, const VisualHullRangeOptions& options) {
+  const FloatMap intervals = VisualHullIntervals(ref, ref_mask, others, search_min_m,
+                                                 search_max_m, options.pixel_step, options);
+  std::vector<double> near_ends, far_ends;
+  for (size_t i = 0; i < intervals.NumPixels(); ++i) {
+    if (intervals.Channel(0)[i] > 0) {
+      near_ends.push_back(intervals.Channel(0)[i]);
+      far_ends.push_back(intervals.Channel(1)[i]);
+    }
+  }
+  if (static_cast<int>(near_ends.size()) < std::max(1, options.min_rays_in_hull)) return false;
+  const auto percentile = [](std::vector<double>* values, double percent) {
+    const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
+    const size_t i = std::min(values->size() - 1, static_cast<size_t>(p * (values->size() - 1)));
+    std::nth_element(values->begin(), values->begin() + i, values->end());
+    return (*values)[i];
   };
-  const double lo = at(options.low_percentile), hi = at(options.high_percentile);
+  const double lo = percentile(&near_ends, options.low_percentile);
+  const double hi = percentile(&far_ends, options.high_percentile);
   const double margin = std::max(options.margin_fraction * (hi - lo), options.margin_m);
   *min_m = std::max(lo - margin, search_min_m);
   *max_m = std::min(hi + margin, search_max_m);

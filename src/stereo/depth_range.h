@@ -30,12 +30,26 @@ struct VisualHullRangeOptions {
   // only is carved by one epipolar line, which crosses that view's mask over long stretches
   // when the two views are close (handheld h10: 0.21-5.03 m with 1, 0.42-0.67 m with 3).
   int min_observing_views = 3;
-  // Fewer kept samples than this: no range (returns false).
-  int min_kept_samples = 20;
+  // Fewer sampled rays entering the hull than this: no range (returns false).
+  int min_rays_in_hull = 4;
 };
 
+// Per pixel of the reference (every pixel_step-th column and row inside its mask), the first
+// stretch of its ray inside the hull: a 2-channel map (near, far) in metres at the reference's
+// size, (0, 0) where not sampled or where the ray never enters the hull. The near end is a
+// lower bound on the depth of whatever the pixel sees: the first surface along the ray lies
+// inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
+// phantom stretch of hull, carved by no view, may lie in front of the surface.) The ends are
+// refined by bisection between the depth samples.
+FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
+                             const std::vector<std::pair<StereoCamera, FloatMap>>& others,
+                             double search_min_m, double search_max_m, int pixel_step,
+                             const VisualHullRangeOptions& options = VisualHullRangeOptions());
+
 // Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
-// pixel convention. Returns false (outputs untouched) when too few samples are kept.
+// pixel convention. The range spans the percentiles of the near ends (low) and far ends (high)
+// of VisualHullIntervals, sampled every options.pixel_step pixels. Returns false (outputs
+// untouched) when too few rays enter the hull.
 bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,

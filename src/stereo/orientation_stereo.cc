@@ -26,6 +26,7 @@
 #include "src/opencl/opencl_context.h"
 #include "src/orientation/orientation_field.h"
 #include "src/stereo/depth_estimator.h"
+#include "src/stereo/consistency_filter.h"
 #include "src/stereo/depth_range.h"
 
 namespace hairmvs {
@@ -58,6 +59,31 @@ bool FromString(const std::string& text, DepthSampling* sampling) {
   return true;
 }
 
+std::string ToString(VisualHullBound bound) {
+  switch (bound) {
+    case VisualHullBound::kOff:
+      return "off";
+    case VisualHullBound::kPenalty:
+      return "penalty";
+    case VisualHullBound::kFilter:
+      return "filter";
+  }
+  return "?";
+}
+
+bool FromString(const std::string& text, VisualHullBound* bound) {
+  if (text == "off") {
+    *bound = VisualHullBound::kOff;
+  } else if (text == "penalty") {
+    *bound = VisualHullBound::kPenalty;
+  } else if (text == "filter") {
+    *bound = VisualHullBound::kFilter;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 int OrientationStereoOptions::WindowPx(int level) const {
   if (level <= 0) return window_px_level0;
   if (level == 1) return window_px_level1;
@@ -72,6 +98,13 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "depth_max must exceed depth_min; ";
   }
   if (num_depths < 3) e << "num_depths must be >= 3; ";
+  if (!(visual_hull_tolerance_m >= 0)) e << "visual_hull_tolerance_m must be >= 0; ";
+  if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
+  if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
+  if (geom_consistency_only && !geom_consistency) {
+    e << "geom_consistency_only needs geom_consistency; ";
+  }
+  if (visual_hull_mask_dilation_px < 0) e << "visual_hull_mask_dilation_px must be >= 0; ";
   if (num_levels < 1) e << "num_levels must be >= 1; ";
   if (window_px_level0 < 1 || window_px_level1 < 1 || window_px_level2 < 1) {
     e << "window_px_level* must be >= 1; ";
@@ -232,14 +265,21 @@ class ViewLoader {
   }
 
   // Camera and mask at the processing resolution of every view that has a mask except
-  // `exclude`, for the visual hull depth range (masks read once, then cached).
+  // `exclude`, for the visual hull (masks read and dilated once, then cached).
   std::vector<std::pair<StereoCamera, FloatMap>> MaskedViews(const std::string& exclude) {
     if (masked_views_.empty()) {
       for (const std::string& name : workspace_.ImageNames()) {
         if (workspace_.MaskPath(name).empty()) continue;
         const StereoCamera camera = ProcessingCamera(name);
-        masked_views_.emplace_back(
-            name, std::make_pair(camera, Mask(name, camera.width, camera.height)));
+        FloatMap mask = Mask(name, camera.width, camera.height);
+        const int radius = options_.visual_hull_mask_dilation_px;
+        if (radius > 0) {
+          cv::Mat wrapped(mask.Height(), mask.Width(), CV_32F, mask.Data().data());
+          cv::dilate(wrapped, wrapped,
+                     cv::getStructuringElement(cv::MORPH_ELLIPSE,
+                                               cv::Size(2 * radius + 1, 2 * radius + 1)));
+        }
+        masked_views_.emplace_back(name, std::make_pair(camera, std::move(mask)));
       }
     }
     std::vector<std::pair<StereoCamera, FloatMap>> views;
@@ -317,6 +357,22 @@ class ViewLoader {
   std::vector<std::pair<std::string, std::pair<StereoCamera, FloatMap>>> masked_views_;
 };
 
+// Writes a depth map, its normal map and, with `png`, their pictures, as `type` (geometric or
+// photometric) maps.
+void WriteDepthAndNormals(const Workspace& workspace, const std::string& name,
+                          const std::string& type, const FloatMap& depth,
+                          const Eigen::Matrix3d& K, bool png) {
+  const std::string depth_path = workspace.DepthMapPath(name, type);
+  const std::string normal_path = workspace.NormalMapPath(name, type);
+  WriteMat(depth_path, depth);
+  const FloatMap normals = NormalMapFromDepthMap(depth, K);
+  WriteMat(normal_path, normals);
+  if (png) {
+    WriteDepthPng(depth_path + ".png", depth);
+    WriteNormalPng(normal_path + ".png", normals);
+  }
+}
+
 }  // namespace
 
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
@@ -345,9 +401,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   std::shared_ptr<OpenCLContext> context = OpenCLContext::Create(device_spec);
   ViewLoader loader(workspace, options, context, timings);
   OrientationStereoResult result;
-  Progress progress("orientation_stereo", static_cast<int>(names.size()));
-  for (size_t i = 0; i < names.size(); ++i) {
-    const std::string& name = names[i];
+  std::vector<std::string> estimated;  // views whose depth map was estimated in this run
+  const std::vector<std::string> no_names;
+  const std::vector<std::string>& to_estimate = options.geom_consistency_only ? no_names : names;
+  Progress progress("orientation_stereo", static_cast<int>(to_estimate.size()));
+  for (size_t i = 0; i < to_estimate.size(); ++i) {
+    const std::string& name = to_estimate[i];
     progress.Start(static_cast<int>(i), name);
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
@@ -397,19 +456,33 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                   << "--OrientationStereo.depth_min and depth_max");
     const DepthLabels labels(depth_min, depth_max, options.num_depths,
                              options.depth_sampling == DepthSampling::kInverseDepth);
-    const DepthEstimate estimate =
-        EstimateDepthMap(context.get(), ref, sources, mask, labels, options, timings, &progress);
+    // Per pixel, where its ray enters the visual hull: a lower bound on its depth.
+    FloatMap depth_lower_bound;
+    if (options.visual_hull_depth_bound != VisualHullBound::kOff &&
+        !workspace.MaskPath(name).empty()) {
+      ScopedStageTimer timer(timings, "visual hull");
+      const FloatMap intervals =
+          VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
+                              2 * depth_max, /*pixel_step=*/1);
+      depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
+      for (size_t p = 0; p < intervals.NumPixels(); ++p) {
+        const float near_m = intervals.Channel(0)[p];
+        depth_lower_bound.Data()[p] =
+            near_m > 0 ? std::max(0.0f, near_m - static_cast<float>(
+                                                     options.visual_hull_tolerance_m))
+                       : 0.0f;
+      }
+    }
+    const DepthEstimate estimate = EstimateDepthMap(context.get(), ref, sources, mask,
+                                                    depth_lower_bound, labels, options,
+                                                    timings, &progress);
 
     progress.Stage("writing");
-    ScopedStageTimer timer(timings, "writing");
-    const std::string depth_path = workspace.DepthMapPath(name, "geometric");
-    WriteMat(depth_path, estimate.depth);
-    const FloatMap normals = NormalMapFromDepthMap(estimate.depth, ref.camera.K);
-    WriteMat(workspace.NormalMapPath(name, "geometric"), normals);
-    WriteMat(workspace.ConfidenceMapPath(name), estimate.confidence);
-    if (options.write_png) {
-      WriteDepthPng(depth_path + ".png", estimate.depth);
-      WriteNormalPng(workspace.NormalMapPath(name, "geometric") + ".png", normals);
+    {
+      ScopedStageTimer timer(timings, "writing");
+      WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : "geometric",
+                           estimate.depth, ref.camera.K, options.write_png);
+      WriteMat(workspace.ConfidenceMapPath(name), estimate.confidence);
     }
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources, %d valid pixels, "
                 "MRF energy %.4g (coarse) %.4g (fine)\n",
@@ -418,10 +491,73 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                 estimate.num_valid,
                 estimate.coarse_energy, estimate.fine_energy);
     std::fflush(stdout);
-    result.depth_map_paths.push_back(depth_path);
-    ++result.num_views;
+    estimated.push_back(name);
+    if (!options.geom_consistency) {
+      result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
+      ++result.num_views;
+    }
   }
   progress.Finish();
+
+  if (options.geom_consistency) {
+    // The consistency pass: every view estimated now (or, with geom_consistency_only, every
+    // requested view) against its sources' .photometric maps.
+    const std::vector<std::string>& to_filter = options.geom_consistency_only ? names : estimated;
+    Progress filter_progress("geometric consistency", static_cast<int>(to_filter.size()));
+    std::map<std::string, FusionView> photometric;  // read once each
+    auto load = [&](const std::string& name) -> const FusionView* {
+      auto it = photometric.find(name);
+      if (it == photometric.end()) {
+        FusionView view;
+        const std::string path = workspace.DepthMapPath(name, "photometric");
+        if (ExistsFile(path)) {
+          const StereoCamera camera = loader.ProcessingCamera(name);
+          view.name = name;
+          view.depth = ReadMat(path);
+          THROW_IF(view.depth.Channels() != 1, path << ": not a depth map (" << view.depth.Channels()
+                                                    << " channels)");
+          view.K = camera.Scaled(view.depth.Width(), view.depth.Height()).K;
+          view.R = camera.R;
+          view.t = camera.t;
+        }
+        it = photometric.emplace(name, std::move(view)).first;
+      }
+      return it->second.depth.Empty() ? nullptr : &it->second;
+    };
+    for (size_t i = 0; i < to_filter.size(); ++i) {
+      const std::string& name = to_filter[i];
+      filter_progress.Start(static_cast<int>(i), name);
+      ScopedStageTimer timer(timings, "consistency");
+      const FusionView* ref = load(name);
+      THROW_IF(ref == nullptr, workspace.DepthMapPath(name, "photometric")
+                                   << ": missing; run orientation_stereo on " << name
+                                   << " first (without geom_consistency_only)");
+      std::vector<const FusionView*> others;
+      const auto it = sources_of.find(name);
+      if (it != sources_of.end()) {
+        for (const std::string& source : it->second) {
+          if (const FusionView* view = load(source)) others.push_back(view);
+        }
+      }
+      FloatMap depth = ref->depth;
+      if (others.empty()) {
+        LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
+                     << ".geometric map is unfiltered (run again with "
+                     << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+      } else {
+        ConsistencyFilterStats stats;
+        depth = FilterDepthMapByConsistency(*ref, others,
+                                            options.geom_consistency_max_error_px,
+                                            options.geom_consistency_min_views, &stats);
+        std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
+                    stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
+      }
+      WriteDepthAndNormals(workspace, name, "geometric", depth, ref->K, options.write_png);
+      result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
+      ++result.num_views;
+    }
+    filter_progress.Finish();
+  }
   result.seconds = total_timer.ElapsedSeconds();
   result.peak_memory_mib = PeakResidentMemoryMiB();
   return result;

@@ -14,6 +14,7 @@
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
+#include "src/core/logging.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/file_util.h"
 #include "src/stereo/stereo_test_util.h"
@@ -119,6 +120,61 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   EXPECT_LT(median, 0.02);
   // The orientation fields were cached for reuse.
   EXPECT_TRUE(ExistsFile(workspace.OrientationMapPath("v1.png", 0)));
+  // Its sources have no depth maps yet: the .geometric map is the estimate, unfiltered.
+  EXPECT_EQ(depth.Data(), ReadMat(workspace.DepthMapPath("v0.png", "photometric")).Data());
+  std::filesystem::remove_all(path);
+}
+
+TEST(OrientationStereoWorkspace, GeometricMapsKeepTheConsistentPixelsOfThePhotometricOnes) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "hairmvs_stereo_consistency_test").string();
+  std::filesystem::remove_all(path);
+  const FloatMap true_depth = WriteWorkspace(path);
+  OrientationStereoOptions options;
+  options.depth_min = 0.7;
+  options.depth_max = 1.5;
+  options.coarse_level = 1;
+  StageTimings timings;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  const Workspace workspace = Workspace::Read(path);
+  const FloatMap photometric = ReadMat(workspace.DepthMapPath("v0.png", "photometric"));
+  const FloatMap geometric = ReadMat(workspace.DepthMapPath("v0.png", "geometric"));
+  ASSERT_EQ(photometric.Data().size(), geometric.Data().size());
+  size_t kept = 0, estimated = 0, kept_error = 0, dropped_error = 0, dropped = 0;
+  for (size_t p = 0; p < photometric.Data().size(); ++p) {
+    const float g = geometric.Data()[p], f = photometric.Data()[p];
+    EXPECT_TRUE(g == f || g == 0.0f) << p;  // a pixel is kept as it is, or dropped
+    if (f > 0 && true_depth.Data()[p] > 0) {
+      ++estimated;
+      const bool bad = std::abs(f - true_depth.Data()[p]) > 0.05;
+      if (g > 0) {
+        ++kept;
+        kept_error += bad;
+      } else {
+        ++dropped;
+        dropped_error += bad;
+      }
+    }
+  }
+  std::printf("consistency: kept %zu of %zu (%zu > 5 cm off); dropped %zu (%zu > 5 cm off)\n",
+              kept, estimated, kept_error, dropped, dropped_error);
+  // The plane is seen by all four views: most of it agrees; the kept pixels are no worse in
+  // share of gross errors than the estimate as a whole.
+  EXPECT_GT(kept, estimated * 3 / 4);
+  EXPECT_LE(kept_error * estimated, (kept_error + dropped_error) * kept);
+  // The consistency pass alone, on the existing .photometric maps, gives the same map.
+  options.geom_consistency_only = true;
+  EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, options, &timings).num_views, 1);
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), geometric.Data());
+  // ... and says which view has no .photometric map to filter.
+  std::filesystem::remove(workspace.DepthMapPath("v1.png", "photometric"));
+  try {
+    RunOrientationStereo(path, {"v1.png"}, options, &timings);
+    ADD_FAILURE() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("v1.png.photometric.bin: missing"), std::string::npos)
+        << e.what();
+  }
   std::filesystem::remove_all(path);
 }
 

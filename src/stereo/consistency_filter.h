@@ -1,0 +1,31 @@
+#pragma once
+// Geometric consistency filter of depth maps (COLMAP's patch_match_stereo `filter` with
+// `geom_consistency`, in its simplest form): a pixel keeps its depth only where enough other
+// views, at the pixel its back-projected point projects to, have a depth that agrees. Pixels
+// whose depth is wrong (hair seen through gaps, matching on the wrong layer) rarely agree with
+// an independent estimate from another viewpoint.
+
+#include <vector>
+
+#include "src/core/float_map.h"
+#include "src/fusion/fusion_view.h"
+
+namespace hairmvs {
+
+struct ConsistencyFilterStats {
+  int num_checked = 0;  // valid pixels of the reference
+  int num_kept = 0;
+};
+
+// Returns `ref.depth` with 0 where fewer than `min_consistent_views` of `others` agree. A view
+// agrees when the pixel's point, scaled along that view's line of sight to the view's depth at
+// the pixel it projects to (SfM convention, nearest pixel), projects back into the reference
+// within max_reprojection_error_px of the pixel's centre (COLMAP's forward-backward
+// reprojection error, so the tolerance in depth scales with the baseline). Maps may differ in
+// size from the images as long as each K matches its map.
+FloatMap FilterDepthMapByConsistency(const FusionView& ref,
+                                     const std::vector<const FusionView*>& others,
+                                     double max_reprojection_error_px, int min_consistent_views,
+                                     ConsistencyFilterStats* stats = nullptr);
+
+}  // namespace hairmvs

@@ -1,0 +1,77 @@
+#include "src/stereo/consistency_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+
+namespace hairmvs {
+namespace {
+
+// A camera at `center` looking at the origin along +z-ish (no roll), and the exact z-depth map
+// of the world plane z_world = 1 seen by it (all cameras sit at z_world = 0 and look up +z).
+FusionView PlaneView(const Eigen::Vector3d& center, double yaw_rad) {
+  FusionView view;
+  view.K << 100, 0, 40, 0, 100, 30, 0, 0, 1;
+  view.R = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitY()).toRotationMatrix().transpose();
+  view.t = -view.R * center;
+  view.depth = FloatMap(80, 60, 1, 0.0f);
+  const Eigen::Matrix3d K_inv = view.K.inverse();
+  for (int row = 0; row < 60; ++row) {
+    for (int col = 0; col < 80; ++col) {
+      // Ray in world coordinates; intersect z_world = 1.
+      const Eigen::Vector3d ray_cam = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+      const Eigen::Vector3d ray = view.R.transpose() * ray_cam;
+      const double s = (1.0 - center.z()) / ray.z();
+      view.depth.At(row, col) = static_cast<float>(s * ray_cam.z());
+    }
+  }
+  return view;
+}
+
+TEST(ConsistencyFilterTest, KeepsAgreeingDepthsAndDropsAWrongPatch) {
+  const FusionView left = PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1);
+  FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  const FusionView right = PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1);
+  // A patch 30% too far (about 2 px of disparity), as a match on a hair layer behind the
+  // surface would be.
+  for (int row = 20; row < 30; ++row) {
+    for (int col = 30; col < 45; ++col) ref.depth.At(row, col) *= 1.3f;
+  }
+  ConsistencyFilterStats stats;
+  const FloatMap filtered = FilterDepthMapByConsistency(ref, {&left, &right}, 1.0, 1, &stats);
+  EXPECT_EQ(stats.num_checked, 80 * 60);
+  for (int row = 20; row < 30; ++row) {
+    for (int col = 30; col < 45; ++col) EXPECT_EQ(filtered.At(row, col), 0.0f);
+  }
+  // Away from the patch every pixel that a neighbour sees keeps its exact depth: the yawed
+  // neighbours see the whole centre of the reference.
+  for (int row = 0; row < 60; ++row) {
+    for (int col = 20; col < 60; ++col) {
+      if (row >= 20 && row < 30 && col >= 30 && col < 45) continue;
+      EXPECT_EQ(filtered.At(row, col), ref.depth.At(row, col)) << row << " " << col;
+    }
+  }
+  EXPECT_LE(stats.num_kept, 80 * 60 - 150);
+  EXPECT_GE(stats.num_kept, 40 * 60 - 150);
+}
+
+TEST(ConsistencyFilterTest, NeedsTheRequiredNumberOfAgreeingViews) {
+  const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  const FusionView left = PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1);
+  FusionView wrong = PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1);
+  for (float& d : wrong.depth.Data()) d *= 0.7f;  // ~4 px off everywhere
+  ConsistencyFilterStats one, two;
+  FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 1, &one);
+  const FloatMap none = FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 2, &two);
+  EXPECT_GT(one.num_kept, 40 * 60);
+  EXPECT_EQ(two.num_kept, 0);
+  for (float d : none.Data()) EXPECT_EQ(d, 0.0f);
+  // No other view: nothing is consistent unless none is required.
+  ConsistencyFilterStats zero;
+  const FloatMap kept = FilterDepthMapByConsistency(ref, {}, 1.0, 0, &zero);
+  EXPECT_EQ(zero.num_kept, 80 * 60);
+  EXPECT_EQ(kept.Data(), ref.depth.Data());
+}
+
+}  // namespace
+}  // namespace hairmvs
