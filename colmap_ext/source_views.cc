@@ -425,7 +425,11 @@ DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
     return col >= 0 && row >= 0 && col < mask.Width() && row < mask.Height() &&
            mask.At(row, col) > 0.0f;
   });
-  if (masked.num_points >= min_points) return masked;
+  if (masked.num_points >= min_points) {
+    DepthRange range = masked;
+    range.inside_mask = true;
+    return range;
+  }
   return ComputeDepthRange(model, image_id);
 }
 

@@ -96,6 +96,7 @@ struct DepthRange {
   double min_m = -1;
   double max_m = -1;
   int num_points = 0;
+  bool inside_mask = false;  // from the points inside a mask only (not the fallback)
 };
 // COLMAP's Model::ComputeDepthRanges: depths d > 0 of the sparse points in the image's tracks,
 // sorted; [0.75 * d[floor(0.01 n)], 1.25 * d[floor(0.99 n)]]; (-1, -1) when there are none.
