@@ -230,5 +230,38 @@ TEST(DepthRange, ColmapRuleAndOverrides) {
   EXPECT_NE(error.find("depth_min"), std::string::npos);
 }
 
+TEST(DepthRange, InsideTheMaskOnlyWhenEnoughPointsAreInside) {
+  Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}}, {"a.png", "b.png"}, {});
+  Image& a = model.images.at(1);
+  a.points2D.clear();
+  const int width = static_cast<int>(model.cameras.at(a.camera_id).width);
+  const int height = static_cast<int>(model.cameras.at(a.camera_id).height);
+  // 30 points: depths 1..15 seen in the left half of the image, 16..30 in the right half.
+  for (int k = 1; k <= 30; ++k) {
+    Point2D observation;
+    observation.xy = Eigen::Vector2d(k <= 15 ? 2.5 : width - 2.5, height / 2.0);
+    observation.point3D_id = k;
+    a.points2D.push_back(observation);
+    Point3D p;
+    p.point3D_id = k;
+    p.xyz = Eigen::Vector3d(0, 0, k);
+    p.track = {{1, static_cast<uint32_t>(k - 1)}};
+    model.points3D[k] = p;
+  }
+  FloatMap left_half(width, height, 1, 0.0f);
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width / 2; ++col) left_half.At(row, col) = 1.0f;
+  }
+  const DepthRange inside = ComputeDepthRange(model, 1, left_half, 10);
+  EXPECT_TRUE(inside.inside_mask);
+  EXPECT_EQ(inside.num_points, 15);
+  EXPECT_DOUBLE_EQ(inside.max_m, 1.25 * 15);
+  // Too few points inside: COLMAP's rule on all of them, not marked as inside the mask.
+  const DepthRange fallback = ComputeDepthRange(model, 1, left_half, 16);
+  EXPECT_FALSE(fallback.inside_mask);
+  EXPECT_EQ(fallback.num_points, 30);
+  EXPECT_FALSE(ComputeDepthRange(model, 1).inside_mask);
+}
+
 }  // namespace
 }  // namespace hairmvs

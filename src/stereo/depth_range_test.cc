@@ -66,6 +66,65 @@ TEST(DepthRangeTest, VisualHullRangeIsTightAroundTheSphere) {
   EXPECT_LE(max_m, 1.3);
 }
 
+// 3 x 3 maximum: a mask that keeps every pixel the sphere touches, not only those whose
+// centre ray hits it (orientation_stereo dilates the masks for the same reason).
+FloatMap Dilated(const FloatMap& mask) {
+  FloatMap out(mask.Width(), mask.Height(), 1, 0.0f);
+  for (int row = 0; row < mask.Height(); ++row) {
+    for (int col = 0; col < mask.Width(); ++col) {
+      for (int dr = -1; dr <= 1; ++dr) {
+        for (int dc = -1; dc <= 1; ++dc) {
+          const int r = row + dr, c = col + dc;
+          if (r >= 0 && c >= 0 && r < mask.Height() && c < mask.Width() && mask.At(r, c) > 0) {
+            out.At(row, col) = 1.0f;
+          }
+        }
+      }
+    }
+  }
+  return out;
+}
+
+TEST(DepthRangeTest, HullIntervalsStartInFrontOfTheSurface) {
+  Scene scene = MakeScene(7);
+  for (auto& view : scene.others) view.second = Dilated(view.second);
+  const FloatMap mask = SphereMask(scene.ref);
+  const FloatMap intervals =
+      VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, /*pixel_step=*/1);
+  ASSERT_EQ(intervals.Channels(), 2);
+  const Eigen::Matrix3d K_inv = scene.ref.K.inverse();
+  int rays = 0;
+  std::vector<double> gaps;
+  for (int row = 0; row < scene.ref.height; ++row) {
+    for (int col = 0; col < scene.ref.width; ++col) {
+      const float near_m = intervals.At(row, col, 0), far_m = intervals.At(row, col, 1);
+      if (!(mask.At(row, col) > 0.5f)) {
+        EXPECT_EQ(near_m, 0.0f);  // only the reference's masked pixels are sampled
+        continue;
+      }
+      ASSERT_GT(near_m, 0.0f) << row << " " << col;
+      ++rays;
+      // The true z-depth where the ray enters the sphere (the reference sits at the origin
+      // looking down +z, so camera and world frames agree).
+      const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1);
+      const double a = ray.squaredNorm(), b = -ray.dot(kCentre);
+      const double c = kCentre.squaredNorm() - kRadius * kRadius;
+      const double disc = b * b - a * c;
+      if (disc < 0) continue;  // a rim pixel: hit at its centre by the mask's normalised ray
+      const double entry = (-b - std::sqrt(disc)) / a;
+      // The hull contains the sphere: its first stretch starts at or before the surface (the
+      // bisection resolves the transition to well under a millimetre) and ends behind it.
+      EXPECT_LE(near_m, entry + 1e-3) << row << " " << col;
+      EXPECT_GE(far_m, entry - 1e-3) << row << " " << col;
+      gaps.push_back(entry - near_m);
+    }
+  }
+  ASSERT_GT(rays, 100);
+  std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
+  // Eight views around it carve the hull close to the sphere's front.
+  EXPECT_LT(gaps[gaps.size() / 2], 0.03);
+}
+
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {
   Scene scene = MakeScene(7);
   const FloatMap ref_mask = SphereMask(scene.ref);
