@@ -18,6 +18,8 @@ namespace hairmvs {
 
 // Which source views each reference uses (colmap_ext/source_views.h: --SourceViews.*).
 struct SourceViewOptions;
+// How missing orientation fields are computed (hairmvs/orientation_fields.h).
+struct OrientationFieldOptions;
 
 // What is matched between views.
 enum class StereoCost {
@@ -220,13 +222,17 @@ struct OrientationStereoResult {
 // Computes depth maps for `image_names` (empty: every image of the workspace). `device_spec`
 // picks the OpenCL device ("" = first GPU, else first CPU; an index; or a name substring).
 // `source_views` chooses the source views (null: SourceViewOptions' defaults, 4 views); an
-// explicit patch-match.cfg list is capped to its max_num_source_views.
+// explicit patch-match.cfg list is capped to its max_num_source_views. `field_options` (null:
+// the defaults, the paper's filter) computes the orientation fields that are not cached in
+// stereo/orientation_maps/ (its num_levels is replaced by options.num_levels).
 // Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const std::vector<std::string>& image_names,
                                              const OrientationStereoOptions& options,
                                              StageTimings* timings,
                                              const std::string& device_spec = "",
-                                             const SourceViewOptions* source_views = nullptr);
+                                             const SourceViewOptions* source_views = nullptr,
+                                             const OrientationFieldOptions* field_options =
+                                                 nullptr);
 
 }  // namespace hairmvs

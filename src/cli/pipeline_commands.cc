@@ -142,7 +142,7 @@ int RunPipeline(int argc, char** argv) {
     stereo_options.write_png = stereo_options.write_png || write_png;
     const OrientationStereoResult result = RunOrientationStereo(
         workspace_path, image_names, stereo_options, &timings, opencl_options.device,
-        &source_options);
+        &source_options, &orientation_options);
     std::printf("%s\n", result.BriefReport().c_str());
   }
   if (HasStage(stages, "fusion")) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "colmap_ext/source_views.h"
+#include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/cli/command_registry.h"
 #include "src/core/logging.h"
@@ -27,11 +28,13 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   bool write_png = false;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
+  OrientationFieldOptions field_options;
   OpenCLOptions opencl_options;
   OptionParser parser("orientation_stereo",
                       "Depth maps of a COLMAP dense workspace from orientation fields (Luo et al. "
-                      "2012, Section 3): writes stereo/depth_maps/<name>.geometric.bin, "
-                      "stereo/normal_maps/<name>.geometric.bin and stereo/confidence_maps/.");
+                      "2012, Section 3): writes stereo/depth_maps/<name>.photometric.bin (as "
+                      "estimated) and <name>.geometric.bin (consistent with the source views), "
+                      "normal maps likewise, and stereo/confidence_maps/.");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
   parser.Add("image_names", &image_names,
              "comma-separated reference images (default: all), e.g. to share a workspace "
@@ -39,6 +42,7 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   parser.Add("write_png", &write_png, "also write coloured depth and normal pictures");
   parser.AddSection("OrientationStereo", &options);
   parser.AddSection("SourceViews", &source_options);
+  parser.AddSection("OrientationField", &field_options);
   parser.AddSection("OpenCL", &opencl_options);
   if (!parser.Parse(argc, argv)) return 0;
   if (parser.WasGiven("write_png")) options.write_png = write_png;
@@ -46,8 +50,9 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);
   std::printf("%s", parser.Values().c_str());
   StageTimings timings;
-  const OrientationStereoResult result = RunOrientationStereo(
-      workspace_path, image_names, options, &timings, opencl_options.device, &source_options);
+  const OrientationStereoResult result =
+      RunOrientationStereo(workspace_path, image_names, options, &timings, opencl_options.device,
+                           &source_options, &field_options);
   PrintSummary(result, timings);
   return 0;
 }
@@ -65,6 +70,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   double filter_geom_consistency_max_cost = 3.0;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
+  OrientationFieldOptions field_options;
   OpenCLOptions opencl_options;
   OptionParser parser("patch_match_stereo",
                       "Drop-in for `colmap patch_match_stereo`: orientation-field depth maps in "
@@ -92,6 +98,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              "patch-match.cfg to use instead of stereo/patch-match.cfg (as colmap's)");
   parser.AddSection("OrientationStereo", &options);
   parser.AddSection("SourceViews", &source_options);
+  parser.AddSection("OrientationField", &field_options);
   parser.AddSection("OpenCL", &opencl_options);
   const std::string kPatchMatchOnly = "PatchMatch-specific; orientation stereo has no such setting";
   for (const char* name :
@@ -138,7 +145,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   StageTimings timings;
   const OrientationStereoResult result =
       RunOrientationStereo(workspace_path, {}, options, &timings, opencl_options.device,
-                           &source_options);
+                           &source_options, &field_options);
   PrintSummary(result, timings);
   return 0;
 }

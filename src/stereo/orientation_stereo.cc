@@ -227,9 +227,10 @@ void WriteNormalPng(const std::string& path, const FloatMap& normals) {
 class ViewLoader {
  public:
   ViewLoader(const Workspace& workspace, const OrientationStereoOptions& options,
+             const OrientationFieldOptions& field_options,
              std::shared_ptr<OpenCLContext> context, StageTimings* timings)
-      : workspace_(workspace), options_(options), context_(std::move(context)),
-        timings_(timings) {}
+      : workspace_(workspace), options_(options), field_options_(field_options),
+        context_(std::move(context)), timings_(timings) {}
 
   const StereoViewData& Load(const std::string& name) {
     for (auto it = cache_.begin(); it != cache_.end(); ++it) {
@@ -322,7 +323,7 @@ class ViewLoader {
       gray = ResizeArea(ReadImageGray(workspace_.ImagePath(name)), w, h);
       const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
-        OrientationFieldOptions field_options;
+        OrientationFieldOptions field_options = field_options_;
         field_options.num_levels = options_.num_levels;
         computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
       }
@@ -350,6 +351,7 @@ class ViewLoader {
 
   const Workspace& workspace_;
   const OrientationStereoOptions& options_;
+  const OrientationFieldOptions field_options_;
   std::shared_ptr<OpenCLContext> context_;
   StageTimings* timings_;
   std::unique_ptr<OrientationFieldComputer> computer_;
@@ -380,7 +382,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const OrientationStereoOptions& options,
                                              StageTimings* timings,
                                              const std::string& device_spec,
-                                             const SourceViewOptions* source_views) {
+                                             const SourceViewOptions* source_views,
+                                             const OrientationFieldOptions* field_options) {
   Timer total_timer;
   std::string error;
   THROW_IF(!options.Check(&error), "invalid --OrientationStereo options: " << error);
@@ -399,7 +402,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   }
 
   std::shared_ptr<OpenCLContext> context = OpenCLContext::Create(device_spec);
-  ViewLoader loader(workspace, options, context, timings);
+  const OrientationFieldOptions fields =
+      field_options != nullptr ? *field_options : OrientationFieldOptions();
+  THROW_IF(!fields.Check(&error), "invalid --OrientationField options: " << error);
+  ViewLoader loader(workspace, options, fields, context, timings);
   OrientationStereoResult result;
   std::vector<std::string> estimated;  // views whose depth map was estimated in this run
   const std::vector<std::string> no_names;

@@ -15,6 +15,7 @@
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/logging.h"
+#include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/file_util.h"
 #include "src/stereo/stereo_test_util.h"
@@ -123,6 +124,35 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   // Its sources have no depth maps yet: the .geometric map is the estimate, unfiltered.
   EXPECT_EQ(depth.Data(), ReadMat(workspace.DepthMapPath("v0.png", "photometric")).Data());
   std::filesystem::remove_all(path);
+}
+
+TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
+  const std::string root =
+      (std::filesystem::temp_directory_path() / "hairmvs_stereo_fields_test").string();
+  std::filesystem::remove_all(root);
+  const std::string stereo_path = JoinPaths(root, "stereo"), fields_path = JoinPaths(root, "f");
+  WriteWorkspace(stereo_path);
+  WriteWorkspace(fields_path);
+  OrientationFieldOptions wide;
+  wide.sigma_across_inner_px = 1.0;
+  wide.sigma_across_outer_px = 2.0;
+  OrientationStereoOptions options;
+  options.depth_min = 0.7;
+  options.depth_max = 1.5;
+  options.coarse_level = 1;
+  StageTimings timings;
+  RunOrientationStereo(stereo_path, {"v0.png"}, options, &timings, "", nullptr, &wide);
+  // The fields cached by the stereo are those `orientation_fields` makes with the same filter,
+  // and not the default filter's.
+  RunOrientationFields(fields_path, wide, OrientationFieldsRunOptions(), &timings);
+  const Workspace stereo_ws = Workspace::Read(stereo_path);
+  const Workspace fields_ws = Workspace::Read(fields_path);
+  const FloatMap cached = ReadMat(stereo_ws.OrientationMapPath("v1.png", 0));
+  EXPECT_EQ(cached.Data(), ReadMat(fields_ws.OrientationMapPath("v1.png", 0)).Data());
+  RunOrientationFields(fields_path, OrientationFieldOptions(), OrientationFieldsRunOptions(),
+                       &timings);
+  EXPECT_NE(cached.Data(), ReadMat(fields_ws.OrientationMapPath("v1.png", 0)).Data());
+  std::filesystem::remove_all(root);
 }
 
 TEST(OrientationStereoWorkspace, GeometricMapsKeepTheConsistentPixelsOfThePhotometricOnes) {
