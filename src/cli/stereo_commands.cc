@@ -67,7 +67,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   double depth_min = -1, depth_max = -1, min_triangulation_angle = 1.0;
   bool geom_consistency = true, filter = true;
   int filter_min_num_consistent = 1;
-  double filter_geom_consistency_max_cost = 3.0;
+  double filter_geom_consistency_max_cost = 4.0;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
   OrientationFieldOptions field_options;
