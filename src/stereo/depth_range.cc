@@ -42,7 +42,7 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing,
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              double search_min_m, double search_max_m, int pixel_step,
-                             const VisualHullRangeOptions& options) {
+                             const VisualHullRangeOptions& options, bool find_far_ends) {
   CHECK_EQ(ref_mask.Width(), ref.width);
   CHECK_EQ(ref_mask.Height(), ref.height);
   CHECK_GT(pixel_step, 0);
@@ -81,7 +81,7 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
       }
       if (entry < 0) continue;
       int exit = n;  // first sample outside after the entry
-      for (int k = entry + 1; k < n; ++k) {
+      for (int k = entry + 1; find_far_ends && k < n; ++k) {
         if (!inside(k)) {
           exit = k;
           break;
@@ -98,7 +98,9 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
       const double near_k = entry > 0 ? refine(entry - 1, entry) : entry;
       const double far_k = exit < n ? refine(exit, exit - 1) : n - 1;
       intervals.At(row, col, 0) = static_cast<float>(1.0 / inverse_depth(near_k));
-      intervals.At(row, col, 1) = static_cast<float>(1.0 / inverse_depth(far_k));
+      if (find_far_ends) {
+        intervals.At(row, col, 1) = static_cast<float>(1.0 / inverse_depth(far_k));
+      }
     }
   }
   return intervals;

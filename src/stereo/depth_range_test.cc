@@ -123,6 +123,13 @@ TEST(DepthRangeTest, HullIntervalsStartInFrontOfTheSurface) {
   std::nth_element(gaps.begin(), gaps.begin() + gaps.size() / 2, gaps.end());
   // Eight views around it carve the hull close to the sphere's front.
   EXPECT_LT(gaps[gaps.size() / 2], 0.03);
+  // Without the far ends: the same near ends, far channel 0.
+  const FloatMap near_only = VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, 1,
+                                                 VisualHullRangeOptions(), false);
+  for (size_t p = 0; p < near_only.NumPixels(); ++p) {
+    EXPECT_EQ(near_only.Channel(0)[p], intervals.Channel(0)[p]);
+    EXPECT_EQ(near_only.Channel(1)[p], 0.0f);
+  }
 }
 
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {

@@ -478,7 +478,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       ScopedStageTimer timer(timings, "visual hull");
       const FloatMap intervals =
           VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
-                              2 * depth_max, /*pixel_step=*/1);
+                              2 * depth_max, /*pixel_step=*/1, VisualHullRangeOptions(),
+                              /*find_far_ends=*/false);
       depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
       for (size_t p = 0; p < intervals.NumPixels(); ++p) {
         const float near_m = intervals.Channel(0)[p];
