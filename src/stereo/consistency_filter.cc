@@ -27,15 +27,12 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
         int c, r;
         double z;
         if (!other->Project(world, &c, &r, &z)) continue;
-        (void)z;
         const float other_depth = other->depth.At(r, c);
         if (!(other_depth > 0)) continue;
         // Forward-backward: the other view's surface point at that pixel, seen from the
         // reference (COLMAP's geometric consistency error). The exact (sub-pixel) projection
         // is used, so that an exact surface reprojects exactly.
-        const Eigen::Vector3d cam = other->R * world + other->t;
-        const Eigen::Vector3d other_world =
-            other->R.transpose() * (cam * (other_depth / cam.z()) - other->t);
+        const Eigen::Vector3d other_world = other->SurfaceOnRay(world, z, other_depth);
         const Eigen::Vector3d back = ref.K * (ref.R * other_world + ref.t);
         if (!(back.z() > 0)) continue;
         const Eigen::Vector2d reprojected = back.head<2>() / back.z();
