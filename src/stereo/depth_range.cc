@@ -41,8 +41,10 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing,
 
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
-                             double search_min_m, double search_max_m, int pixel_step,
-                             const VisualHullRangeOptions& options, bool find_far_ends) {
+                             double search_min_m, double search_max_m,
+                             const VisualHullRangeOptions& options) {
+  const int pixel_step = options.pixel_step;
+  const bool find_far_ends = options.find_far_ends;
   CHECK_EQ(ref_mask.Width(), ref.width);
   CHECK_EQ(ref_mask.Height(), ref.height);
   CHECK_GT(pixel_step, 0);
@@ -110,8 +112,10 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,
                           double* max_m, const VisualHullRangeOptions& options) {
-  const FloatMap intervals = VisualHullIntervals(ref, ref_mask, others, search_min_m,
-                                                 search_max_m, options.pixel_step, options);
+  VisualHullRangeOptions with_far_ends = options;
+  with_far_ends.find_far_ends = true;
+  const FloatMap intervals =
+      VisualHullIntervals(ref, ref_mask, others, search_min_m, search_max_m, with_far_ends);
   std::vector<double> near_ends, far_ends;
   for (size_t i = 0; i < intervals.NumPixels(); ++i) {
     if (intervals.Channel(0)[i] > 0) {

@@ -15,6 +15,10 @@ namespace hairmvs {
 struct VisualHullRangeOptions {
   // Reference pixels sampled: every pixel_step-th column and row inside the mask.
   int pixel_step = 8;
+  // VisualHullIntervals: also find where each ray leaves the hull. Without, the far channel is
+  // 0: walking through the hull checks every view at every sample, most of the cost
+  // (synth_straight_gantry: 1.1 s per 960 x 640 view with 31 others).
+  bool find_far_ends = true;
   // Depth samples per ray, uniform in inverse depth over the search range.
   int num_samples = 256;
   // Percentiles (0-100) of the kept depths that give the range (robust to stray samples).
@@ -34,25 +38,23 @@ struct VisualHullRangeOptions {
   int min_rays_in_hull = 4;
 };
 
-// Per pixel of the reference (every pixel_step-th column and row inside its mask), the first
-// stretch of its ray inside the hull: a 2-channel map (near, far) in metres at the reference's
-// size, (0, 0) where not sampled or where the ray never enters the hull. The near end is a
+// Per pixel of the reference (every options.pixel_step-th column and row inside its mask), the
+// first stretch of its ray inside the hull: a 2-channel map (near, far) in metres at the
+// reference's size, (0, 0) where not sampled or where the ray never enters the hull. The near end is a
 // lower bound on the depth of whatever the pixel sees: the first surface along the ray lies
 // inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
 // phantom stretch of hull, carved by no view, may lie in front of the surface.) The ends are
-// refined by bisection between the depth samples. Without `find_far_ends` the far channel is 0:
-// walking through the hull checks every view at every sample, most of the cost (synth_straight_
-// gantry: 1.1 s per 960 x 640 view with 31 others).
+// refined by bisection between the depth samples; the far ends only with
+// options.find_far_ends.
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
-                             double search_min_m, double search_max_m, int pixel_step,
-                             const VisualHullRangeOptions& options = VisualHullRangeOptions(),
-                             bool find_far_ends = true);
+                             double search_min_m, double search_max_m,
+                             const VisualHullRangeOptions& options = VisualHullRangeOptions());
 
 // Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
 // pixel convention. The range spans the percentiles of the near ends (low) and far ends (high)
-// of VisualHullIntervals, sampled every options.pixel_step pixels. Returns false (outputs
-// untouched) when too few rays enter the hull.
+// of VisualHullIntervals (with far ends), sampled every options.pixel_step pixels. Returns false
+// (outputs untouched) when too few rays enter the hull.
 bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,

@@ -85,12 +85,19 @@ FloatMap Dilated(const FloatMap& mask) {
   return out;
 }
 
+VisualHullRangeOptions EveryPixel(bool find_far_ends) {
+  VisualHullRangeOptions options;
+  options.pixel_step = 1;
+  options.find_far_ends = find_far_ends;
+  return options;
+}
+
 TEST(DepthRangeTest, HullIntervalsStartInFrontOfTheSurface) {
   Scene scene = MakeScene(7);
   for (auto& view : scene.others) view.second = Dilated(view.second);
   const FloatMap mask = SphereMask(scene.ref);
   const FloatMap intervals =
-      VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, /*pixel_step=*/1);
+      VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, EveryPixel(true));
   ASSERT_EQ(intervals.Channels(), 2);
   const Eigen::Matrix3d K_inv = scene.ref.K.inverse();
   int rays = 0;
@@ -124,8 +131,8 @@ TEST(DepthRangeTest, HullIntervalsStartInFrontOfTheSurface) {
   // Eight views around it carve the hull close to the sphere's front.
   EXPECT_LT(gaps[gaps.size() / 2], 0.03);
   // Without the far ends: the same near ends, far channel 0.
-  const FloatMap near_only = VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, 1,
-                                                 VisualHullRangeOptions(), false);
+  const FloatMap near_only =
+      VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, EveryPixel(false));
   for (size_t p = 0; p < near_only.NumPixels(); ++p) {
     EXPECT_EQ(near_only.Channel(0)[p], intervals.Channel(0)[p]);
     EXPECT_EQ(near_only.Channel(1)[p], 0.0f);

@@ -457,7 +457,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         // (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with the points:
         // 3.4 x finer labels).
         range_source = "visual hull";
-        if (range.inside_mask && std::max(hull_min, range.min_m) < std::min(hull_max, range.max_m)) {
+        if (range.inside_mask &&
+            std::max(hull_min, range.min_m) < std::min(hull_max, range.max_m)) {
           hull_min = std::max(hull_min, range.min_m);
           hull_max = std::min(hull_max, range.max_m);
           range_source = "visual hull and sparse points in mask";
@@ -476,10 +477,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     if (options.visual_hull_depth_bound != VisualHullBound::kOff &&
         !workspace.MaskPath(name).empty()) {
       ScopedStageTimer timer(timings, "visual hull");
+      VisualHullRangeOptions every_pixel_entries;
+      every_pixel_entries.pixel_step = 1;
+      every_pixel_entries.find_far_ends = false;  // only the entry bounds the depth
       const FloatMap intervals =
           VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
-                              2 * depth_max, /*pixel_step=*/1, VisualHullRangeOptions(),
-                              /*find_far_ends=*/false);
+                              2 * depth_max, every_pixel_entries);
       depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
       for (size_t p = 0; p < intervals.NumPixels(); ++p) {
         const float near_m = intervals.Channel(0)[p];
@@ -530,8 +533,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           const StereoCamera camera = loader.ProcessingCamera(name);
           view.name = name;
           view.depth = ReadMat(path);
-          THROW_IF(view.depth.Channels() != 1, path << ": not a depth map (" << view.depth.Channels()
-                                                    << " channels)");
+          THROW_IF(view.depth.Channels() != 1,
+                   path << ": not a depth map (" << view.depth.Channels() << " channels)");
           view.K = camera.Scaled(view.depth.Width(), view.depth.Height()).K;
           view.R = camera.R;
           view.t = camera.t;
