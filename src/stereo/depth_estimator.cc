@@ -276,21 +276,25 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     zero_base[l].assign(static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
   }
   std::vector<float> coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
-  // The depth lower bound as labels, on the level-0 grid and (the smallest bound of each
-  // block, so that it never excludes what a finer pixel allows) on the coarse grid.
-  std::vector<float> bound0, bound_coarse;
+  const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  // The depth lower bound as labels on the level-0 grid (-inf = none).
+  std::vector<float> bound0;
   if (!depth_lower_bound.Empty()) {
     CHECK_EQ(depth_lower_bound.Width(), width0);
     CHECK_EQ(depth_lower_bound.Height(), height0);
-    const float none = -std::numeric_limits<float>::infinity();
-    bound0.assign(static_cast<size_t>(width0) * height0, none);
+    bound0.assign(static_cast<size_t>(width0) * height0, -std::numeric_limits<float>::infinity());
     for (size_t p = 0; p < bound0.size(); ++p) {
       const float d = depth_lower_bound.Data()[p];
       if (d > 0) bound0[p] = static_cast<float>(labels.Label(d));
     }
-    const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  }
+  const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;
+  if (penalize && !bound0.empty()) {
+    // On the coarse grid, the smallest bound of each block, so that it never excludes what a
+    // finer pixel allows.
     const int factor = 1 << coarse_level;
-    bound_coarse.assign(static_cast<size_t>(cw) * ch, none);
+    std::vector<float> bound_coarse(static_cast<size_t>(cw) * ch,
+                                    -std::numeric_limits<float>::infinity());
     for (int row = 0; row < height0; ++row) {
       for (int col = 0; col < width0; ++col) {
         const float b = bound0[row * width0 + col];
@@ -299,13 +303,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         if (std::isfinite(b) && (!std::isfinite(coarse) || b < coarse)) coarse = b;
       }
     }
-  }
-  const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;
-  if (penalize && !bound_coarse.empty()) {
     PenalizeInFrontOfBound(bound_coarse, {}, 1.0f, num_depths, &coarse_volume);
   }
   if (progress != nullptr) progress->Stage("MRF (all depths)");
-  const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
   const int coarse_pixels = cw * ch;
   const std::vector<int> coarse_labels =
       solve(coarse_level, num_depths, &coarse_volume, {}, 1.0f, &estimate.coarse_energy);
