@@ -83,15 +83,22 @@ FloatMap WriteWorkspace(const std::string& path) {
   return true_depth;
 }
 
+// The plane of WriteWorkspace lies within this depth range; its 96 x 72 views need only one
+// coarse level.
+OrientationStereoOptions PlaneOptions() {
+  OrientationStereoOptions options;
+  options.depth_min = 0.7;
+  options.depth_max = 1.5;
+  options.coarse_level = 1;
+  return options;
+}
+
 TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane) {
   const std::string path =
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_workspace_test").string();
   std::filesystem::remove_all(path);
   const FloatMap true_depth = WriteWorkspace(path);
-  OrientationStereoOptions options;
-  options.depth_min = 0.7;
-  options.depth_max = 1.5;
-  options.coarse_level = 1;
+  OrientationStereoOptions options = PlaneOptions();
   options.write_png = true;
   StageTimings timings;
   const OrientationStereoResult result =
@@ -136,10 +143,7 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   OrientationFieldOptions wide;
   wide.sigma_across_inner_px = 1.0;
   wide.sigma_across_outer_px = 2.0;
-  OrientationStereoOptions options;
-  options.depth_min = 0.7;
-  options.depth_max = 1.5;
-  options.coarse_level = 1;
+  OrientationStereoOptions options = PlaneOptions();
   StageTimings timings;
   RunOrientationStereo(stereo_path, {"v0.png"}, options, &timings, "", nullptr, &wide);
   // The fields cached by the stereo are those `orientation_fields` makes with the same filter,
@@ -160,10 +164,7 @@ TEST(OrientationStereoWorkspace, GeometricMapsKeepTheConsistentPixelsOfThePhotom
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_consistency_test").string();
   std::filesystem::remove_all(path);
   const FloatMap true_depth = WriteWorkspace(path);
-  OrientationStereoOptions options;
-  options.depth_min = 0.7;
-  options.depth_max = 1.5;
-  options.coarse_level = 1;
+  OrientationStereoOptions options = PlaneOptions();
   StageTimings timings;
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
   const Workspace workspace = Workspace::Read(path);
