@@ -129,21 +129,32 @@ struct OrientationStereoOptions {
   // Photometric cost only: NCC window (px) at every level.
   int ncc_window_px = 7;
   // Geometric consistency, as COLMAP's patch_match_stereo names its passes: each view's depth
-  // map as estimated is written as depth_maps/<name>.photometric.bin; the .geometric.bin map
-  // keeps the pixels that at least geom_consistency_min_views of its source views agree with
-  // (forward-backward reprojection error within geom_consistency_max_error_px, COLMAP's
-  // filter_geom_consistency_max_cost; src/stereo/consistency_filter.h).
+  // map as first estimated is written as depth_maps/<name>.photometric.bin. The geometric pass
+  // then estimates each view again with its source views' .photometric maps as a prior
+  // (COLMAP's geometric pass; GeometricPrior in src/stereo/depth_estimator.h) and keeps the
+  // pixels that at least geom_consistency_min_views of those maps agree with (forward-backward
+  // reprojection error within geom_consistency_max_error_px, COLMAP's
+  // filter_geom_consistency_max_cost; src/stereo/consistency_filter.h) as .geometric.bin.
   // Sources without a .photometric map yet (a job array's other jobs) are skipped; run again
   // with geom_consistency_only once all jobs are done. Off: .geometric.bin is the estimate.
   bool geom_consistency = true;
   double geom_consistency_max_error_px = 4.0;
   int geom_consistency_min_views = 1;
   // 4 px rather than COLMAP's 1: the hair's own depth texture is a few pixels of disparity
-  // deep. Kept hair pixels / per-pixel median for 3 / 4 / 5 px: synthesised curly T group
-  // (defaults, seed 1) 90.7 / 92.3 / 93.5% at 2.33 / 2.37 / 2.41 mm; seed 2 91.9 / 93.5 / 94.6%
-  // at 2.40 / 2.44 / 2.48 mm; synth_straight_gantry 86.1 / 88.2 / 89.6% at 4.52 / 4.63 / 4.71 mm
-  // (1 / 2 px kept 83 / 90% of seed 2's estimate earlier in development).
-  // Only the consistency pass, on the existing .photometric maps (no estimation).
+  // deep. Measured without the prior (filter only), kept hair pixels / per-pixel median for
+  // 3 / 4 / 5 px: synthesised curly T group (defaults, seed 1) 90.7 / 92.3 / 93.5% at
+  // 2.33 / 2.37 / 2.41 mm; seed 2 91.9 / 93.5 / 94.6% at 2.40 / 2.44 / 2.48 mm;
+  // synth_straight_gantry 86.1 / 88.2 / 89.6% at 4.52 / 4.63 / 4.71 mm.
+  // The prior's weight, relative to the data term's median range over the coarse labels (0:
+  // no second estimation, the .photometric map is only filtered), and the reprojection error
+  // (px) at which a depth costs the most (COLMAP's geom_consistency_max_cost: 3). Weight 0 /
+  // 0.5 / 1 / 2 on synth_straight_gantry groups 3 and 5 (8 views): kept 84.5 / 90.5 / 93.3 /
+  // 95.1% of the hair pixels at a per-pixel median of 4.79 / 4.80 / 4.82 / 4.89 mm; the
+  // synthesised curly T group (seed 1), 0 / 1: 92.3 / 96.7% at 2.37 / 2.36 mm (mean 3.90 /
+  // 3.71). It doubles the stereo's time (every view is estimated twice).
+  double geom_prior_weight = 1.0;
+  double geom_prior_max_error_px = 3.0;
+  // Only the geometric pass, on the existing .photometric maps.
   bool geom_consistency_only = false;
   // Reuse / write stereo/orientation_maps/<name>.l<k>.bin.
   bool reuse_orientation_maps = true;
@@ -200,8 +211,12 @@ struct OrientationStereoOptions {
       "consistency: largest forward-backward reprojection error in px");
     v("geom_consistency_min_views", &geom_consistency_min_views,
       "consistency: source views that must agree for a pixel to keep its depth");
+    v("geom_prior_weight", &geom_prior_weight,
+      "geometric pass: weight of the sources' depth maps as a prior (0: filter only)");
+    v("geom_prior_max_error_px", &geom_prior_max_error_px,
+      "geometric pass: reprojection error (px) at which the prior costs the most");
     v("geom_consistency_only", &geom_consistency_only,
-      "only run the consistency pass on existing .photometric maps");
+      "only the geometric pass (prior and filter), on the existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,
       "read stereo/orientation_maps/*.l<k>.bin when present and of the right size");
     v("write_orientation_maps", &write_orientation_maps,

@@ -68,6 +68,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   bool geom_consistency = true, filter = true;
   int filter_min_num_consistent = 1;
   double filter_geom_consistency_max_cost = 4.0;
+  double geom_consistency_max_cost = 3.0;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
   OrientationFieldOptions field_options;
@@ -85,8 +86,12 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   parser.Add("PatchMatchStereo.min_triangulation_angle", &min_triangulation_angle,
              "source views: minimum triangulation angle in degrees");
   parser.Add("PatchMatchStereo.geom_consistency", &geom_consistency,
-             "write .photometric maps, then .geometric maps filtered by consistency with the "
-             "source views (0: the .geometric maps are unfiltered)");
+             "write .photometric maps, then .geometric maps estimated again with the source "
+             "views' maps as a prior and filtered by consistency with them (0: the .geometric "
+             "maps are the unfiltered estimates)");
+  parser.Add("PatchMatchStereo.geom_consistency_max_cost", &geom_consistency_max_cost,
+             "geometric pass: reprojection error in px at which the sources' depth maps, as a "
+             "prior, cost the most");
   parser.Add("PatchMatchStereo.filter_min_num_consistent", &filter_min_num_consistent,
              "source views that must agree for a pixel to keep its depth");
   parser.Add("PatchMatchStereo.filter_geom_consistency_max_cost",
@@ -106,12 +111,14 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
         "PatchMatchStereo.sigma_spatial", "PatchMatchStereo.sigma_color",
         "PatchMatchStereo.num_samples", "PatchMatchStereo.ncc_sigma",
         "PatchMatchStereo.incident_angle_sigma", "PatchMatchStereo.num_iterations",
-        "PatchMatchStereo.geom_consistency_regularizer",
-        "PatchMatchStereo.geom_consistency_max_cost", "PatchMatchStereo.filter_min_ncc",
+        "PatchMatchStereo.filter_min_ncc",
         "PatchMatchStereo.filter_min_triangulation_angle",
         "PatchMatchStereo.write_consistency_graph"}) {
     parser.AddIgnored(name, kPatchMatchOnly);
   }
+  parser.AddIgnored("PatchMatchStereo.geom_consistency_regularizer",
+                    "the prior's weight is relative to the orientation cost's range here: "
+                    "--OrientationStereo.geom_prior_weight");
   parser.AddIgnored("PatchMatchStereo.gpu_index", "use --OpenCL.device to pick the device");
   parser.AddIgnored("PatchMatchStereo.cache_size", "views are cached by count, not size");
   parser.AddIgnored("PatchMatchStereo.allow_missing_files", "missing files are errors here");
@@ -128,6 +135,9 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   }
   if (parser.WasGiven("PatchMatchStereo.geom_consistency")) {
     options.geom_consistency = geom_consistency;
+  }
+  if (parser.WasGiven("PatchMatchStereo.geom_consistency_max_cost")) {
+    options.geom_prior_max_error_px = geom_consistency_max_cost;
   }
   if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent")) {
     options.geom_consistency_min_views = filter_min_num_consistent;

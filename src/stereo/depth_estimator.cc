@@ -5,6 +5,8 @@
 #include <limits>
 #include <memory>
 
+#include <Eigen/LU>
+
 #include "src/core/logging.h"
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
@@ -125,6 +127,81 @@ void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
 
 }  // namespace
 
+void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_camera,
+                       double level0_px_per_grid_px, const DepthLabels& labels,
+                       const std::vector<float>& base, float step, int num_labels,
+                       float cost_scale, std::vector<float>* volume) {
+  if (prior.views.empty() || !(prior.weight > 0)) return;
+  const int width = grid_camera.width, height = grid_camera.height;
+  const size_t n = static_cast<size_t>(width) * height;
+  CHECK_EQ(volume->size(), n * num_labels);
+  const Eigen::Matrix3d K_inv = grid_camera.K.inverse();
+  const Eigen::Matrix3d R_t = grid_camera.R.transpose();
+  const double max_error = prior.max_error_px;
+  const float per_view =
+      static_cast<float>(prior.weight * cost_scale / prior.views.size());
+#pragma omp parallel for schedule(dynamic, 4)
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      const size_t p = static_cast<size_t>(row) * width + col;
+      const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+      for (int k = 0; k < num_labels; ++k) {
+        const double depth = labels.Depth((base.empty() ? 0.0f : base[p]) + k * step);
+        const Eigen::Vector3d world = R_t * (ray * depth - grid_camera.t);
+        double total = 0;
+        for (const FusionView* view : prior.views) {
+          double error = max_error;
+          int c, r;
+          double z;
+          if (view->Project(world, &c, &r, &z)) {
+            const float view_depth = view->depth.At(r, c);
+            if (view_depth > 0) {
+              const Eigen::Vector3d back =
+                  grid_camera.K * (grid_camera.R * view->SurfaceOnRay(world, z, view_depth) +
+                                   grid_camera.t);
+              if (back.z() > 0) {
+                error = std::min(
+                    max_error,
+                    (back.head<2>() / back.z() - centre).norm() * level0_px_per_grid_px);
+              }
+            }
+          }
+          total += error / max_error;
+        }
+        (*volume)[static_cast<size_t>(k) * n + p] += per_view * static_cast<float>(total);
+      }
+    }
+  }
+}
+
+namespace {
+
+// The median of the cost's range across labels over the pixels with contrast (above 1e-3 of the
+// largest range: masked pixels cost 0 at every label, up to rounding).
+float MedianCostRange(const std::vector<float>& volume, size_t num_pixels, int num_labels) {
+  std::vector<float> ranges;
+  ranges.reserve(num_pixels);
+  for (size_t p = 0; p < num_pixels; ++p) {
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    for (int k = 0; k < num_labels; ++k) {
+      const float c = volume[k * num_pixels + p];
+      lo = std::min(lo, c);
+      hi = std::max(hi, c);
+    }
+    if (hi > lo) ranges.push_back(hi - lo);
+  }
+  if (ranges.empty()) return 0.0f;
+  const float largest = *std::max_element(ranges.begin(), ranges.end());
+  ranges.erase(std::remove_if(ranges.begin(), ranges.end(),
+                              [largest](float r) { return r <= 1e-3f * largest; }),
+               ranges.end());
+  std::nth_element(ranges.begin(), ranges.begin() + ranges.size() / 2, ranges.end());
+  return ranges[ranges.size() / 2];
+}
+
+}  // namespace
+
 FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps) {
   CHECK_EQ(orientation.Channels(), 2);
   const int width = orientation.Width(), height = orientation.Height();
@@ -159,7 +236,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                const FloatMap& mask, const FloatMap& depth_lower_bound,
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
-                               Progress* progress) {
+                               Progress* progress, const GeometricPrior* prior) {
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
   THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
   const bool photometric = options.cost == StereoCost::kPhotometric;
@@ -277,6 +354,14 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   }
   std::vector<float> coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
   const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
+  float prior_scale = 0;
+  if (use_prior) {
+    ScopedStageTimer timer(timings, "geometric prior");
+    prior_scale = MedianCostRange(coarse_volume, static_cast<size_t>(cw) * ch, num_depths);
+    AddGeometricPrior(*prior, ref.camera.Scaled(cw, ch), static_cast<double>(width0) / cw,
+                      labels, {}, 1.0f, num_depths, prior_scale, &coarse_volume);
+  }
   // The depth lower bound as labels on the level-0 grid (-inf = none).
   std::vector<float> bound0;
   if (!depth_lower_bound.Empty()) {
@@ -354,6 +439,11 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     }
     if (progress != nullptr) progress->Stage("cost volume and aggregation (fine band)");
     std::vector<float> fine_volume = build_volume(0, band, base, step);
+    if (use_prior) {
+      ScopedStageTimer timer(timings, "geometric prior");
+      AddGeometricPrior(*prior, ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step,
+                        band, prior_scale, &fine_volume);
+    }
     if (penalize && !bound0.empty()) {
       PenalizeInFrontOfBound(bound0, base[0], step, band, &fine_volume);
     }

@@ -9,6 +9,7 @@
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/float_map.h"
 #include "src/core/timer.h"
+#include "src/fusion/fusion_view.h"
 #include "src/stereo/stereo_geometry.h"
 
 namespace hairmvs {
@@ -41,6 +42,27 @@ struct DepthEstimate {
   int num_valid = 0;
 };
 
+// COLMAP's geometric pass: other views' depth maps as a prior on this view's depth. A depth D
+// at pixel p costs weight * cost_scale * mean over the views of min(e, max_error_px) /
+// max_error_px, e the forward-backward reprojection error (level-0 pixels) of p's point at D
+// through that view's map (src/stereo/consistency_filter.h); a view that does not see the point
+// or has no depth there counts as max_error_px (COLMAP's geom_consistency_max_cost).
+// cost_scale: the median over the pixels of the data term's range across the coarse labels,
+// so that weight is relative to the data term whatever its units.
+struct GeometricPrior {
+  std::vector<const FusionView*> views;
+  double weight = 0;
+  double max_error_px = 0;
+};
+
+// Adds the prior to `volume` ([label][row][col] on the grid of `grid_camera`, whose pixels are
+// `level0_px_per_grid_px` level-0 pixels wide) for labels v = base(p) + k * step (base empty =
+// 0). Plain C++ (OpenMP): a few projections per label, next to the cost volume's hundreds.
+void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_camera,
+                       double level0_px_per_grid_px, const DepthLabels& labels,
+                       const std::vector<float>& base, float step, int num_labels,
+                       float cost_scale, std::vector<float>* volume);
+
 // `depth_lower_bound` (level-0 grid, metres, 0 = none; may be empty): labels in front of it get
 // the pixel's worst cost plus one cost range per label of excess, in both stages.
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
@@ -48,7 +70,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                const FloatMap& mask, const FloatMap& depth_lower_bound,
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
-                               Progress* progress = nullptr);
+                               Progress* progress = nullptr,
+                               const GeometricPrior* prior = nullptr);
 
 // Paper Eq. 9: sub-label offsets (in labels, within [-0.5, 0.5]) from the costs at each pixel's
 // label and its two neighbours. volume: [label][pixel]; labels at either end get 0.

@@ -9,6 +9,7 @@
 #include <list>
 #include <map>
 #include <memory>
+#include <optional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -30,6 +31,15 @@
 #include "src/stereo/depth_range.h"
 
 namespace hairmvs {
+
+namespace {
+
+struct ViewEstimate {
+  DepthEstimate estimate;
+  Eigen::Matrix3d K;  // the camera of the depth map's grid
+};
+
+}  // namespace
 
 std::string ToString(StereoCost cost) {
   return cost == StereoCost::kOrientation ? "orientation" : "photometric";
@@ -100,6 +110,8 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (num_depths < 3) e << "num_depths must be >= 3; ";
   if (!(visual_hull_tolerance_m >= 0)) e << "visual_hull_tolerance_m must be >= 0; ";
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
+  if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
+  if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
   if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
   if (geom_consistency_only && !geom_consistency) {
     e << "geom_consistency_only needs geom_consistency; ";
@@ -411,16 +423,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   const std::vector<std::string> no_names;
   const std::vector<std::string>& to_estimate = options.geom_consistency_only ? no_names : names;
   Progress progress("orientation_stereo", static_cast<int>(to_estimate.size()));
-  for (size_t i = 0; i < to_estimate.size(); ++i) {
-    const std::string& name = to_estimate[i];
-    progress.Start(static_cast<int>(i), name);
+  // One view's depth map, with the other views' maps as a prior in the geometric pass; nothing
+  // when the view has no source views.
+  auto estimate_view = [&](const std::string& name, Progress* progress,
+                           const GeometricPrior* prior) -> std::optional<ViewEstimate> {
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
       LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
                    << "view); no depth map written";
-      continue;
+      return std::nullopt;
     }
-    progress.Stage("orientation fields");
+    progress->Stage("orientation fields");
     std::vector<std::string> source_names = it->second;
     if (static_cast<int>(source_names.size()) > source_options.max_num_source_views) {
       source_names.resize(source_options.max_num_source_views);
@@ -494,22 +507,29 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     const DepthEstimate estimate = EstimateDepthMap(context.get(), ref, sources, mask,
                                                     depth_lower_bound, labels, options,
-                                                    timings, &progress);
+                                                    timings, progress, prior);
 
+    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "
+                "MRF energy %.4g (coarse) %.4g (fine)\n",
+                name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
+                depth_max, range_source.c_str(), static_cast<int>(sources.size()),
+                prior != nullptr ? " and their depth maps" : "", estimate.num_valid,
+                estimate.coarse_energy, estimate.fine_energy);
+    std::fflush(stdout);
+    return ViewEstimate{estimate, ref.camera.K};
+  };
+  for (size_t i = 0; i < to_estimate.size(); ++i) {
+    const std::string& name = to_estimate[i];
+    progress.Start(static_cast<int>(i), name);
+    const std::optional<ViewEstimate> view = estimate_view(name, &progress, nullptr);
+    if (!view) continue;
     progress.Stage("writing");
     {
       ScopedStageTimer timer(timings, "writing");
       WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : "geometric",
-                           estimate.depth, ref.camera.K, options.write_png);
-      WriteMat(workspace.ConfidenceMapPath(name), estimate.confidence);
+                           view->estimate.depth, view->K, options.write_png);
+      WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
     }
-    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources, %d valid pixels, "
-                "MRF energy %.4g (coarse) %.4g (fine)\n",
-                name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
-                depth_max, range_source.c_str(), static_cast<int>(sources.size()),
-                estimate.num_valid,
-                estimate.coarse_energy, estimate.fine_energy);
-    std::fflush(stdout);
     estimated.push_back(name);
     if (!options.geom_consistency) {
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
@@ -546,7 +566,6 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     for (size_t i = 0; i < to_filter.size(); ++i) {
       const std::string& name = to_filter[i];
       filter_progress.Start(static_cast<int>(i), name);
-      ScopedStageTimer timer(timings, "consistency");
       const FusionView* ref = load(name);
       THROW_IF(ref == nullptr, workspace.DepthMapPath(name, "photometric")
                                    << ": missing; run orientation_stereo on " << name
@@ -558,20 +577,34 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           if (const FusionView* view = load(source)) others.push_back(view);
         }
       }
-      FloatMap depth = ref->depth;
+      FusionView estimate = *ref;
       if (others.empty()) {
         LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
       } else {
+        if (options.geom_prior_weight > 0) {
+          // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
+          GeometricPrior prior;
+          prior.views = others;
+          prior.weight = options.geom_prior_weight;
+          prior.max_error_px = options.geom_prior_max_error_px;
+          if (std::optional<ViewEstimate> view = estimate_view(name, &filter_progress, &prior)) {
+            estimate.depth = std::move(view->estimate.depth);
+            estimate.K = view->K;
+          }
+        }
+        filter_progress.Stage("consistency filter");
+        ScopedStageTimer timer(timings, "consistency");
         ConsistencyFilterStats stats;
-        depth = FilterDepthMapByConsistency(*ref, others,
-                                            options.geom_consistency_max_error_px,
-                                            options.geom_consistency_min_views, &stats);
+        estimate.depth = FilterDepthMapByConsistency(estimate, others,
+                                                     options.geom_consistency_max_error_px,
+                                                     options.geom_consistency_min_views, &stats);
         std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
                     stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
       }
-      WriteDepthAndNormals(workspace, name, "geometric", depth, ref->K, options.write_png);
+      WriteDepthAndNormals(workspace, name, "geometric", estimate.depth, estimate.K,
+                           options.write_png);
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
       ++result.num_views;
     }

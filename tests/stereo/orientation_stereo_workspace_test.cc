@@ -25,8 +25,8 @@ namespace {
 
 using namespace testing_util;
 
-// Writes the workspace; returns the true depth of view 0.
-FloatMap WriteWorkspace(const std::string& path) {
+// Writes the workspace; returns the true depth of view 0 (of every view in `true_depths`).
+FloatMap WriteWorkspace(const std::string& path, std::vector<FloatMap>* true_depths = nullptr) {
   Surface plane;
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.3), 0, -std::cos(0.3));
@@ -49,6 +49,7 @@ FloatMap WriteWorkspace(const std::string& path) {
   for (size_t i = 0; i < cameras.size(); ++i) {
     const RenderedView view = RenderView(cameras[i], plane, strands);
     if (i == 0) true_depth = view.depth;
+    if (true_depths != nullptr) true_depths->push_back(view.depth);
     Image image;
     image.image_id = static_cast<uint32_t>(i + 1);
     image.camera_id = 1;
@@ -159,12 +160,13 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   std::filesystem::remove_all(root);
 }
 
-TEST(OrientationStereoWorkspace, GeometricMapsKeepTheConsistentPixelsOfThePhotometricOnes) {
+TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhotometricPixels) {
   const std::string path =
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_consistency_test").string();
   std::filesystem::remove_all(path);
   const FloatMap true_depth = WriteWorkspace(path);
   OrientationStereoOptions options = PlaneOptions();
+  options.geom_prior_weight = 0;  // the filter alone
   StageTimings timings;
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
   const Workspace workspace = Workspace::Read(path);
@@ -205,6 +207,66 @@ TEST(OrientationStereoWorkspace, GeometricMapsKeepTheConsistentPixelsOfThePhotom
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("v1.png.photometric.bin: missing"), std::string::npos)
         << e.what();
+  }
+  std::filesystem::remove_all(path);
+}
+
+TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAsAPrior) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "hairmvs_stereo_prior_test").string();
+  std::filesystem::remove_all(path);
+  std::vector<FloatMap> true_depths;
+  WriteWorkspace(path, &true_depths);
+  const std::vector<std::string> names = {"v0.png", "v1.png", "v2.png", "v3.png"};
+  OrientationStereoOptions options = PlaneOptions();
+  StageTimings timings;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  EXPECT_GT(timings.Get("geometric prior"), 0.0);
+  const Workspace workspace = Workspace::Read(path);
+  std::vector<FloatMap> with_prior;
+  for (const std::string& name : names) {
+    with_prior.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
+  }
+  // The filter alone, on the same .photometric maps.
+  options.geom_prior_weight = 0;
+  options.geom_consistency_only = true;
+  RunOrientationStereo(path, names, options, &timings);
+  for (size_t v = 0; v < names.size(); ++v) {
+    const FloatMap filtered = ReadMat(workspace.DepthMapPath(names[v], "geometric"));
+    size_t changed = 0, prior_bad = 0, filter_bad = 0;
+    std::vector<double> errors;
+    for (size_t p = 0; p < filtered.NumPixels(); ++p) {
+      const float f = filtered.Data()[p], g = with_prior[v].Data()[p];
+      const float truth = true_depths[v].Data()[p];
+      changed += f != g;
+      if (g > 0 && truth > 0) {
+        errors.push_back(std::abs(g - truth));
+        prior_bad += errors.back() > 0.05;
+      }
+      filter_bad += f > 0 && truth > 0 && std::abs(f - truth) > 0.05;
+    }
+    ASSERT_GT(errors.size(), filtered.NumPixels() / 2) << names[v];
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    std::printf("%s: geometric pass with the prior: %zu depths, median |error| %.4f m, %zu > 5 "
+                "cm off (filter alone: %zu); %zu pixels differ\n",
+                names[v].c_str(), errors.size(), errors[errors.size() / 2], prior_bad,
+                filter_bad, changed);
+    // Estimated again (not only filtered), and the plane still recovered as in the first
+    // estimate (see ImageNamesWritesOnlyItsViewsAndRecoversThePlane). On this small scene the
+    // views' borders fail alike, and the prior pulls one view's border onto its neighbours'
+    // errors (v0: 388 depths more than 5 cm off against 39 filtered alone) while it mends
+    // others (v2: 912 against 1174); on rendered hair it keeps more pixels at the same median
+    // (README, accuracy).
+    EXPECT_GT(changed, 0u) << names[v];
+    EXPECT_LT(errors[errors.size() / 2], 0.02) << names[v];
+  }
+  // The geometric pass alone, from the .photometric maps, reproduces the maps.
+  options.geom_prior_weight = OrientationStereoOptions().geom_prior_weight;
+  RunOrientationStereo(path, names, options, &timings);
+  for (size_t v = 0; v < names.size(); ++v) {
+    EXPECT_EQ(ReadMat(workspace.DepthMapPath(names[v], "geometric")).Data(),
+              with_prior[v].Data())
+        << names[v];
   }
   std::filesystem::remove_all(path);
 }
