@@ -571,8 +571,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                    << ": missing; run orientation_stereo on " << name
                                    << " first (without geom_consistency_only)");
       std::vector<const FusionView*> others;
+      size_t num_sources = 0;
       const auto it = sources_of.find(name);
       if (it != sources_of.end()) {
+        num_sources = it->second.size();
         for (const std::string& source : it->second) {
           if (const FusionView* view = load(source)) others.push_back(view);
         }
@@ -583,7 +585,13 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
       } else {
-        if (options.geom_prior_weight > 0) {
+        if (options.geom_prior_weight > 0 && others.size() < num_sources) {
+          // A job of an array whose neighbours are not done: the prior would depend on which.
+          LOG(WARNING) << name << ": " << others.size() << " of its " << num_sources
+                       << " source views have a .photometric depth map yet; its .geometric map "
+                       << "is only filtered (run again with "
+                       << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+        } else if (options.geom_prior_weight > 0) {
           // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
           GeometricPrior prior;
           prior.views = others;

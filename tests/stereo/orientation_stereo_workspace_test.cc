@@ -268,6 +268,20 @@ TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAs
               with_prior[v].Data())
         << names[v];
   }
+  // A job of an array whose neighbours are not all done: filtered only, no partial prior.
+  std::filesystem::remove(workspace.DepthMapPath("v1.png", "photometric"));
+  StageTimings partial;
+  RunOrientationStereo(path, {"v0.png"}, options, &partial);
+  EXPECT_EQ(partial.Get("geometric prior"), 0.0);
+  const FloatMap first = ReadMat(workspace.DepthMapPath("v0.png", "photometric"));
+  const FloatMap filtered = ReadMat(workspace.DepthMapPath("v0.png", "geometric"));
+  size_t kept = 0;
+  for (size_t p = 0; p < first.NumPixels(); ++p) {
+    const float g = filtered.Data()[p];
+    EXPECT_TRUE(g == first.Data()[p] || g == 0.0f) << p;
+    kept += g > 0;
+  }
+  EXPECT_GT(kept, first.NumPixels() / 2);
   std::filesystem::remove_all(path);
 }
 
