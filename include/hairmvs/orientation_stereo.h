@@ -154,6 +154,10 @@ struct OrientationStereoOptions {
   // 3.71). It doubles the stereo's time (every view is estimated twice).
   double geom_prior_weight = 1.0;
   double geom_prior_max_error_px = 3.0;
+  // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated) from the first
+  // estimate to the geometric pass, which would compute it again (width x height x 32 bytes a
+  // view: 20 MiB at 960 x 640); views beyond it are computed again.
+  int coarse_volume_cache_mib = 2048;
   // Only the geometric pass, on the existing .photometric maps.
   bool geom_consistency_only = false;
   // Reuse / write stereo/orientation_maps/<name>.l<k>.bin.
@@ -215,6 +219,8 @@ struct OrientationStereoOptions {
       "geometric pass: weight of the sources' depth maps as a prior (0: filter only)");
     v("geom_prior_max_error_px", &geom_prior_max_error_px,
       "geometric pass: reprojection error (px) at which the prior costs the most");
+    v("coarse_volume_cache_mib", &coarse_volume_cache_mib,
+      "MiB for keeping the coarse volumes from the first estimate to the geometric pass");
     v("geom_consistency_only", &geom_consistency_only,
       "only the geometric pass (prior and filter), on the existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,

@@ -236,7 +236,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                const FloatMap& mask, const FloatMap& depth_lower_bound,
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
-                               Progress* progress, const GeometricPrior* prior) {
+                               Progress* progress, const GeometricPrior* prior,
+                               std::vector<float>* coarse_volume_cache) {
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
   THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
   const bool photometric = options.cost == StereoCost::kPhotometric;
@@ -352,8 +353,15 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   for (int l = 0; l < num_levels; ++l) {
     zero_base[l].assign(static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
   }
-  std::vector<float> coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
   const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  const size_t coarse_size = static_cast<size_t>(cw) * ch * num_depths;
+  std::vector<float> coarse_volume;
+  if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
+    coarse_volume = *coarse_volume_cache;
+  } else {
+    coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
+    if (coarse_volume_cache != nullptr) *coarse_volume_cache = coarse_volume;
+  }
   const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
   float prior_scale = 0;
   if (use_prior) {

@@ -63,6 +63,10 @@ void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_cam
                        const std::vector<float>& base, float step, int num_labels,
                        float cost_scale, std::vector<float>* volume);
 
+// `coarse_volume_cache` (may be null): the coarse stage's aggregated data term, before any
+// prior or bound, which depends only on the views, labels and options; used when it holds a
+// volume of the coarse grid's size, filled when empty (the geometric pass estimates each view
+// again from the same data: the all-label volume is most of an estimate's work).
 // `depth_lower_bound` (level-0 grid, metres, 0 = none; may be empty): labels in front of it get
 // the pixel's worst cost plus one cost range per label of excess, in both stages.
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
@@ -71,7 +75,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
                                Progress* progress = nullptr,
-                               const GeometricPrior* prior = nullptr);
+                               const GeometricPrior* prior = nullptr,
+                               std::vector<float>* coarse_volume_cache = nullptr);
 
 // Paper Eq. 9: sub-label offsets (in labels, within [-0.5, 0.5]) from the costs at each pixel's
 // label and its two neighbours. volume: [label][pixel]; labels at either end get 0.

@@ -112,6 +112,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
   if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
   if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
+  if (coarse_volume_cache_mib < 0) e << "coarse_volume_cache_mib must be >= 0; ";
   if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
   if (geom_consistency_only && !geom_consistency) {
     e << "geom_consistency_only needs geom_consistency; ";
@@ -426,7 +427,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   // One view's depth map, with the other views' maps as a prior in the geometric pass; nothing
   // when the view has no source views.
   auto estimate_view = [&](const std::string& name, Progress* progress,
-                           const GeometricPrior* prior) -> std::optional<ViewEstimate> {
+                           const GeometricPrior* prior,
+                           std::vector<float>* coarse_volume) -> std::optional<ViewEstimate> {
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
       LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
@@ -507,7 +509,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     const DepthEstimate estimate = EstimateDepthMap(context.get(), ref, sources, mask,
                                                     depth_lower_bound, labels, options,
-                                                    timings, progress, prior);
+                                                    timings, progress, prior, coarse_volume);
 
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "
                 "MRF energy %.4g (coarse) %.4g (fine)\n",
@@ -518,10 +520,21 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     std::fflush(stdout);
     return ViewEstimate{estimate, ref.camera.K};
   };
+  std::map<std::string, std::vector<float>> coarse_cache;  // per view, for the geometric pass
+  size_t coarse_cache_bytes = 0;
   for (size_t i = 0; i < to_estimate.size(); ++i) {
     const std::string& name = to_estimate[i];
     progress.Start(static_cast<int>(i), name);
-    const std::optional<ViewEstimate> view = estimate_view(name, &progress, nullptr);
+    // The geometric pass will estimate this view again from the same data: keep its coarse
+    // volume while the budget allows.
+    std::vector<float>* coarse_volume = nullptr;
+    if (options.geom_consistency && options.geom_prior_weight > 0 &&
+        coarse_cache_bytes < static_cast<size_t>(options.coarse_volume_cache_mib) << 20) {
+      coarse_volume = &coarse_cache[name];
+    }
+    const std::optional<ViewEstimate> view =
+        estimate_view(name, &progress, nullptr, coarse_volume);
+    if (coarse_volume != nullptr) coarse_cache_bytes += sizeof(float) * coarse_volume->size();
     if (!view) continue;
     progress.Stage("writing");
     {
@@ -597,11 +610,16 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           prior.views = others;
           prior.weight = options.geom_prior_weight;
           prior.max_error_px = options.geom_prior_max_error_px;
-          if (std::optional<ViewEstimate> view = estimate_view(name, &filter_progress, &prior)) {
+          const auto cached = coarse_cache.find(name);
+          std::vector<float>* coarse_volume =
+              cached != coarse_cache.end() ? &cached->second : nullptr;
+          if (std::optional<ViewEstimate> view =
+                  estimate_view(name, &filter_progress, &prior, coarse_volume)) {
             estimate.depth = std::move(view->estimate.depth);
             estimate.K = view->K;
           }
         }
+        coarse_cache.erase(name);
         filter_progress.Stage("consistency filter");
         ScopedStageTimer timer(timings, "consistency");
         ConsistencyFilterStats stats;
