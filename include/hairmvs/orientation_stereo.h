@@ -5,9 +5,12 @@
 // reference orientation field as the guide), an MRF solved coarse to fine, sub-pixel refinement
 // and a final guided filter of the depth map.
 //
-// Outputs, in COLMAP's layout: stereo/depth_maps/<name>.geometric.bin (z-depth in metres, 0 =
-// invalid), stereo/normal_maps/<name>.geometric.bin (camera frame, facing the camera),
-// stereo/confidence_maps/<name>.bin, and optionally coloured PNG pictures of both.
+// Outputs, in COLMAP's layout: stereo/depth_maps/<name>.photometric.bin (the first estimate)
+// and <name>.geometric.bin (COLMAP's geometric pass: estimated again with the source views'
+// first estimates as a prior, then filtered by consistency with them; z-depth in metres, 0 =
+// invalid), stereo/normal_maps/ likewise (camera frame, facing the camera),
+// stereo/confidence_maps/<name>.bin (of the map written last), and optionally coloured PNG
+// pictures of depths and normals.
 
 #include <string>
 #include <vector>

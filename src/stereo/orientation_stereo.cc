@@ -617,6 +617,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                   estimate_view(name, &filter_progress, &prior, coarse_volume)) {
             estimate.depth = std::move(view->estimate.depth);
             estimate.K = view->K;
+            // The confidence of the map that is written as .geometric.
+            WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
           }
         }
         coarse_cache.erase(name);
