@@ -6,6 +6,22 @@
 
 namespace hairmvs {
 
+bool ForwardBackwardErrorPx(const FusionView& other, const Eigen::Vector3d& world,
+                            const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
+                            const Eigen::Vector3d& t, const Eigen::Vector2d& centre,
+                            double* error_px) {
+  int c, r;
+  double z;
+  if (!other.Project(world, &c, &r, &z)) return false;
+  const float other_depth = other.depth.At(r, c);
+  if (!(other_depth > 0)) return false;
+  // The exact (sub-pixel) projection is used, so that an exact surface reprojects exactly.
+  const Eigen::Vector3d back = K * (R * other.SurfaceOnRay(world, z, other_depth) + t);
+  if (!(back.z() > 0)) return false;
+  *error_px = (back.head<2>() / back.z() - centre).norm();
+  return true;
+}
+
 FloatMap FilterDepthMapByConsistency(const FusionView& ref,
                                      const std::vector<const FusionView*>& others,
                                      double max_reprojection_error_px, int min_consistent_views,
@@ -24,19 +40,11 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
       const Eigen::Vector2d centre(col + 0.5, row + 0.5);
       int consistent = 0;
       for (const FusionView* other : others) {
-        int c, r;
-        double z;
-        if (!other->Project(world, &c, &r, &z)) continue;
-        const float other_depth = other->depth.At(r, c);
-        if (!(other_depth > 0)) continue;
-        // Forward-backward: the other view's surface point at that pixel, seen from the
-        // reference (COLMAP's geometric consistency error). The exact (sub-pixel) projection
-        // is used, so that an exact surface reprojects exactly.
-        const Eigen::Vector3d other_world = other->SurfaceOnRay(world, z, other_depth);
-        const Eigen::Vector3d back = ref.K * (ref.R * other_world + ref.t);
-        if (!(back.z() > 0)) continue;
-        const Eigen::Vector2d reprojected = back.head<2>() / back.z();
-        if ((reprojected - centre).norm() <= max_reprojection_error_px) ++consistent;
+        double error_px;
+        if (ForwardBackwardErrorPx(*other, world, ref.K, ref.R, ref.t, centre, &error_px) &&
+            error_px <= max_reprojection_error_px) {
+          ++consistent;
+        }
       }
       if (consistent >= min_consistent_views) {
         ++num_kept;

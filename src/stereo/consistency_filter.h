@@ -17,6 +17,16 @@ struct ConsistencyFilterStats {
   int num_kept = 0;
 };
 
+// COLMAP's forward-backward reprojection error: the point `world` (seen at image point
+// `centre` of the camera K, R, t) is taken to `other`'s surface along other's line of sight (the
+// depth of the pixel it projects to, FusionView::SurfaceOnRay), which is projected back into the
+// camera; the distance in pixels to `centre`. False where `other` does not see the point, has no
+// depth there, or its surface point lies behind the camera.
+bool ForwardBackwardErrorPx(const FusionView& other, const Eigen::Vector3d& world,
+                            const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
+                            const Eigen::Vector3d& t, const Eigen::Vector2d& centre,
+                            double* error_px);
+
 // Returns `ref.depth` with 0 where fewer than `min_consistent_views` of `others` agree. A view
 // agrees when the pixel's point, scaled along that view's line of sight to the view's depth at
 // the pixel it projects to (SfM convention, nearest pixel), projects back into the reference

@@ -11,6 +11,7 @@
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
 #include "src/opencl/opencl_context.h"
+#include "src/stereo/consistency_filter.h"
 #include "src/stereo/cost_volume.h"
 #include "src/stereo/guided_filter.h"
 
@@ -151,23 +152,11 @@ void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_cam
         const Eigen::Vector3d world = R_t * (ray * depth - grid_camera.t);
         double total = 0;
         for (const FusionView* view : prior.views) {
-          double error = max_error;
-          int c, r;
-          double z;
-          if (view->Project(world, &c, &r, &z)) {
-            const float view_depth = view->depth.At(r, c);
-            if (view_depth > 0) {
-              const Eigen::Vector3d back =
-                  grid_camera.K * (grid_camera.R * view->SurfaceOnRay(world, z, view_depth) +
-                                   grid_camera.t);
-              if (back.z() > 0) {
-                error = std::min(
-                    max_error,
-                    (back.head<2>() / back.z() - centre).norm() * level0_px_per_grid_px);
-              }
-            }
-          }
-          total += error / max_error;
+          double error_px;
+          const bool seen = ForwardBackwardErrorPx(*view, world, grid_camera.K, grid_camera.R,
+                                                   grid_camera.t, centre, &error_px);
+          total += seen ? std::min(max_error, error_px * level0_px_per_grid_px) / max_error
+                        : 1.0;
         }
         (*volume)[static_cast<size_t>(k) * n + p] += per_view * static_cast<float>(total);
       }

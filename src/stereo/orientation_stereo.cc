@@ -552,8 +552,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   progress.Finish();
 
   if (options.geom_consistency) {
-    // The consistency pass: every view estimated now (or, with geom_consistency_only, every
-    // requested view) against its sources' .photometric maps.
+    // The geometric pass: every view estimated now (or, with geom_consistency_only, every
+    // requested view), estimated again with its sources' .photometric maps as a prior and
+    // filtered by consistency with them.
     const std::vector<std::string>& to_filter = options.geom_consistency_only ? names : estimated;
     Progress filter_progress("geometric consistency", static_cast<int>(to_filter.size()));
     std::map<std::string, FusionView> photometric;  // read once each
