@@ -158,9 +158,10 @@ struct OrientationStereoOptions {
   // the stereo takes about 1.6x as long (32 gantry views: 315 s, 186 s without the prior).
   double geom_prior_weight = 1.0;
   double geom_prior_max_error_px = 3.0;
-  // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated) from the first
-  // estimate to the geometric pass, which would compute it again (width x height x 32 bytes a
-  // view: 20 MiB at 960 x 640); views beyond it are computed again.
+  // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
+  // and visual-hull bound from the first estimate to the geometric pass, which would compute
+  // them again (width x height x 36 bytes a view: 22 MiB at 960 x 640); views beyond it are
+  // computed again.
   int coarse_volume_cache_mib = 2048;
   // Only the geometric pass, on the existing .photometric maps.
   bool geom_consistency_only = false;

@@ -39,6 +39,24 @@ struct ViewEstimate {
   Eigen::Matrix3d K;  // the camera of the depth map's grid
 };
 
+// Where a view's depth is searched: the label range and the visual-hull lower bound.
+struct DepthSearch {
+  double depth_min = 0;
+  double depth_max = 0;  // 0: not computed yet
+  std::string range_source;
+  FloatMap depth_lower_bound;
+};
+
+// What the geometric pass would compute again for a view, kept from its first estimate: the
+// depth search and the coarse stage's all-label volume (EstimateDepthMap), most of the work.
+struct FirstEstimate {
+  DepthSearch search;
+  std::vector<float> coarse_volume;
+  size_t Bytes() const {
+    return sizeof(float) * (coarse_volume.size() + search.depth_lower_bound.Data().size());
+  }
+};
+
 }  // namespace
 
 std::string ToString(StereoCost cost) {
@@ -428,7 +446,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   // when the view has no source views.
   auto estimate_view = [&](const std::string& name, Progress* progress,
                            const GeometricPrior* prior,
-                           std::vector<float>* coarse_volume) -> std::optional<ViewEstimate> {
+                           FirstEstimate* cache) -> std::optional<ViewEstimate> {
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
       LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
@@ -449,92 +467,100 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
     const FloatMap mask =
         loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
-    double depth_min = options.depth_min, depth_max = options.depth_max;
-    std::string range_source = "options";
-    if (depth_min <= 0 || depth_max <= 0) {
-      const uint32_t image_id = workspace.ImageByName(name).image_id;
-      const DepthRange range = options.depth_range_from_mask
-                                   ? ComputeDepthRange(workspace.Model(), image_id, mask)
-                                   : ComputeDepthRange(workspace.Model(), image_id);
-      if (depth_min <= 0) depth_min = range.min_m;
-      if (depth_max <= 0) depth_max = range.max_m;
-      range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
-      // The masks' visual hull, searched over COLMAP's all-points range widened to
-      // [0.5 min, 2 max]: the sparse points of a textured room say little about the head.
-      const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
-      double hull_min = 0, hull_max = 0;
-      if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
-          wide.min_m > 0 && wide.max_m > wide.min_m &&
-          VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * wide.min_m,
-                               2 * wide.max_m, &hull_min, &hull_max)) {
-        // Intersected with the sparse points' range inside the mask where there is one: the
-        // hull of a single T group (4 nearly parallel views) is long along the line of sight
-        // (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with the points:
-        // 3.4 x finer labels).
-        range_source = "visual hull";
-        if (range.inside_mask &&
-            std::max(hull_min, range.min_m) < std::min(hull_max, range.max_m)) {
-          hull_min = std::max(hull_min, range.min_m);
-          hull_max = std::min(hull_max, range.max_m);
-          range_source = "visual hull and sparse points in mask";
+    // The depth range and the visual-hull bound, from the first estimate when the geometric
+    // pass estimates the view again.
+    DepthSearch computed;
+    DepthSearch& search = cache != nullptr ? cache->search : computed;
+    if (search.depth_max <= 0) {
+      double depth_min = options.depth_min, depth_max = options.depth_max;
+      std::string range_source = "options";
+      if (depth_min <= 0 || depth_max <= 0) {
+        const uint32_t image_id = workspace.ImageByName(name).image_id;
+        const DepthRange range = options.depth_range_from_mask
+                                     ? ComputeDepthRange(workspace.Model(), image_id, mask)
+                                     : ComputeDepthRange(workspace.Model(), image_id);
+        if (depth_min <= 0) depth_min = range.min_m;
+        if (depth_max <= 0) depth_max = range.max_m;
+        range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
+        // The masks' visual hull, searched over COLMAP's all-points range widened to
+        // [0.5 min, 2 max]: the sparse points of a textured room say little about the head.
+        const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
+        double hull_min = 0, hull_max = 0;
+        if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
+            wide.min_m > 0 && wide.max_m > wide.min_m &&
+            VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * wide.min_m,
+                                 2 * wide.max_m, &hull_min, &hull_max)) {
+          // Intersected with the sparse points' range inside the mask where there is one: the
+          // hull of a single T group (4 nearly parallel views) is long along the line of sight
+          // (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with the points:
+          // 3.4 x finer labels).
+          range_source = "visual hull";
+          if (range.inside_mask &&
+              std::max(hull_min, range.min_m) < std::min(hull_max, range.max_m)) {
+            hull_min = std::max(hull_min, range.min_m);
+            hull_max = std::min(hull_max, range.max_m);
+            range_source = "visual hull and sparse points in mask";
+          }
+          if (options.depth_min <= 0) depth_min = hull_min;
+          if (options.depth_max <= 0) depth_max = hull_max;
         }
-        if (options.depth_min <= 0) depth_min = hull_min;
-        if (options.depth_max <= 0) depth_max = hull_max;
       }
+      THROW_IF(!(depth_min > 0 && depth_max > depth_min),
+               name << ": no depth range (too few sparse points seen by this view?); give "
+                    << "--OrientationStereo.depth_min and depth_max");
+      // Per pixel, where its ray enters the visual hull: a lower bound on its depth.
+      if (options.visual_hull_depth_bound != VisualHullBound::kOff &&
+          !workspace.MaskPath(name).empty()) {
+        ScopedStageTimer timer(timings, "visual hull");
+        VisualHullRangeOptions every_pixel_entries;
+        every_pixel_entries.pixel_step = 1;
+        every_pixel_entries.find_far_ends = false;  // only the entry bounds the depth
+        const FloatMap intervals =
+            VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
+                                2 * depth_max, every_pixel_entries);
+        search.depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
+        for (size_t p = 0; p < intervals.NumPixels(); ++p) {
+          const float near_m = intervals.Channel(0)[p];
+          search.depth_lower_bound.Data()[p] =
+              near_m > 0 ? std::max(0.0f, near_m - static_cast<float>(
+                                                       options.visual_hull_tolerance_m))
+                         : 0.0f;
+        }
+      }
+      search.depth_min = depth_min;
+      search.depth_max = depth_max;
+      search.range_source = range_source;
     }
-    THROW_IF(!(depth_min > 0 && depth_max > depth_min),
-             name << ": no depth range (too few sparse points seen by this view?); give "
-                  << "--OrientationStereo.depth_min and depth_max");
+    const double depth_min = search.depth_min, depth_max = search.depth_max;
     const DepthLabels labels(depth_min, depth_max, options.num_depths,
                              options.depth_sampling == DepthSampling::kInverseDepth);
-    // Per pixel, where its ray enters the visual hull: a lower bound on its depth.
-    FloatMap depth_lower_bound;
-    if (options.visual_hull_depth_bound != VisualHullBound::kOff &&
-        !workspace.MaskPath(name).empty()) {
-      ScopedStageTimer timer(timings, "visual hull");
-      VisualHullRangeOptions every_pixel_entries;
-      every_pixel_entries.pixel_step = 1;
-      every_pixel_entries.find_far_ends = false;  // only the entry bounds the depth
-      const FloatMap intervals =
-          VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
-                              2 * depth_max, every_pixel_entries);
-      depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
-      for (size_t p = 0; p < intervals.NumPixels(); ++p) {
-        const float near_m = intervals.Channel(0)[p];
-        depth_lower_bound.Data()[p] =
-            near_m > 0 ? std::max(0.0f, near_m - static_cast<float>(
-                                                     options.visual_hull_tolerance_m))
-                       : 0.0f;
-      }
-    }
-    const DepthEstimate estimate = EstimateDepthMap(context.get(), ref, sources, mask,
-                                                    depth_lower_bound, labels, options,
-                                                    timings, progress, prior, coarse_volume);
+
+    DepthEstimate estimate = EstimateDepthMap(
+        context.get(), ref, sources, mask, search.depth_lower_bound, labels, options, timings,
+        progress, prior, cache != nullptr ? &cache->coarse_volume : nullptr);
 
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "
                 "MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
-                depth_max, range_source.c_str(), static_cast<int>(sources.size()),
+                depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
                 prior != nullptr ? " and their depth maps" : "", estimate.num_valid,
                 estimate.coarse_energy, estimate.fine_energy);
     std::fflush(stdout);
-    return ViewEstimate{estimate, ref.camera.K};
+    return ViewEstimate{std::move(estimate), ref.camera.K};
   };
-  std::map<std::string, std::vector<float>> coarse_cache;  // per view, for the geometric pass
-  size_t coarse_cache_bytes = 0;
+  // What the geometric pass would compute again, per view, within the memory budget.
+  std::map<std::string, FirstEstimate> first_estimates;
+  size_t first_estimate_bytes = 0;
   for (size_t i = 0; i < to_estimate.size(); ++i) {
     const std::string& name = to_estimate[i];
     progress.Start(static_cast<int>(i), name);
-    // The geometric pass will estimate this view again from the same data: keep its coarse
-    // volume while the budget allows.
-    std::vector<float>* coarse_volume = nullptr;
+    FirstEstimate* cache = nullptr;
     if (options.geom_consistency && options.geom_prior_weight > 0 &&
-        coarse_cache_bytes < static_cast<size_t>(options.coarse_volume_cache_mib) << 20) {
-      coarse_volume = &coarse_cache[name];
+        first_estimate_bytes < static_cast<size_t>(options.coarse_volume_cache_mib) << 20) {
+      cache = &first_estimates[name];
     }
-    const std::optional<ViewEstimate> view =
-        estimate_view(name, &progress, nullptr, coarse_volume);
-    if (coarse_volume != nullptr) coarse_cache_bytes += sizeof(float) * coarse_volume->size();
+    const std::optional<ViewEstimate> view = estimate_view(name, &progress, nullptr, cache);
+    if (cache != nullptr) first_estimate_bytes += cache->Bytes();
     if (!view) continue;
     progress.Stage("writing");
     {
@@ -611,18 +637,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           prior.views = others;
           prior.weight = options.geom_prior_weight;
           prior.max_error_px = options.geom_prior_max_error_px;
-          const auto cached = coarse_cache.find(name);
-          std::vector<float>* coarse_volume =
-              cached != coarse_cache.end() ? &cached->second : nullptr;
+          const auto cached = first_estimates.find(name);
+          FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
           if (std::optional<ViewEstimate> view =
-                  estimate_view(name, &filter_progress, &prior, coarse_volume)) {
+                  estimate_view(name, &filter_progress, &prior, cache)) {
             estimate.depth = std::move(view->estimate.depth);
             estimate.K = view->K;
             // The confidence of the map that is written as .geometric.
             WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
           }
         }
-        coarse_cache.erase(name);
+        first_estimates.erase(name);
         filter_progress.Stage("consistency filter");
         ScopedStageTimer timer(timings, "consistency");
         ConsistencyFilterStats stats;
