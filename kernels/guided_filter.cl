@@ -31,27 +31,46 @@ __kernel void box_rows(__global const float* in, __global float* out, int width,
   }
 }
 
-// Vertical window means, one work-item per (column, plane): neighbouring work-items read
-// neighbouring addresses. Global (width, num_planes).
+// Vertical window means, one work-item per 8 neighbouring columns of a plane: it reads and
+// writes 8 neighbouring floats per row, which on a CPU device (PoCL runs a work-item's loop to
+// its end before the next work-item) is a third of the cache lines that one column per
+// work-item touches. The same arithmetic per column as one column per work-item.
+// Global (ceil(width / 8), num_planes).
 __kernel void box_cols(__global const float* in, __global float* out, int width, int height,
                        int radius) {
-  const int col = get_global_id(0);
+  const int col0 = 8 * get_global_id(0);
   const int plane = get_global_id(1);
-  if (col >= width) return;
-  const size_t base = (size_t)plane * width * height + col;
+  if (col0 >= width) return;
+  const size_t base = (size_t)plane * width * height + col0;
   __global const float* src = in + base;
   __global float* dst = out + base;
-  float sum = 0.0f;
   const int first = min(radius, height - 1);
-  for (int r = 0; r <= first; ++r) sum += src[(size_t)r * width];
-  for (int r = 0; r < height; ++r) {
-    const int lo = max(r - radius, 0);
-    const int hi = min(r + radius, height - 1);
-    dst[(size_t)r * width] = sum / (float)(hi - lo + 1);
-    const int add = r + radius + 1;
-    const int remove = r - radius;
-    if (add < height) sum += src[(size_t)add * width];
-    if (remove >= 0) sum -= src[(size_t)remove * width];
+  if (col0 + 8 <= width) {
+    float8 sum = (float8)(0.0f);
+    for (int r = 0; r <= first; ++r) sum += vload8(0, src + (size_t)r * width);
+    for (int r = 0; r < height; ++r) {
+      const int lo = max(r - radius, 0);
+      const int hi = min(r + radius, height - 1);
+      vstore8(sum / (float8)((float)(hi - lo + 1)), 0, dst + (size_t)r * width);
+      const int add = r + radius + 1;
+      const int remove = r - radius;
+      if (add < height) sum += vload8(0, src + (size_t)add * width);
+      if (remove >= 0) sum -= vload8(0, src + (size_t)remove * width);
+    }
+    return;
+  }
+  for (int c = 0; c < width - col0; ++c) {  // the last, partial group
+    float sum = 0.0f;
+    for (int r = 0; r <= first; ++r) sum += src[(size_t)r * width + c];
+    for (int r = 0; r < height; ++r) {
+      const int lo = max(r - radius, 0);
+      const int hi = min(r + radius, height - 1);
+      dst[(size_t)r * width + c] = sum / (float)(hi - lo + 1);
+      const int add = r + radius + 1;
+      const int remove = r - radius;
+      if (add < height) sum += src[(size_t)add * width + c];
+      if (remove >= 0) sum -= src[(size_t)remove * width + c];
+    }
   }
 }
 

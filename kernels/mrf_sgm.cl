@@ -1,7 +1,8 @@
 // Semi-global matching on the depth-label MRF (src/mrf/semi_global.h), OpenCL C 1.2.
 //
 // Tunable (build option): NUM_LABELS, the number of labels L (private arrays of 2 L floats).
-// Layouts: cost and sum are [label][row][col] (L * H * W floats); offset, weight are H * W.
+// Layouts: cost and sum are [row][col][label] (H * W * L floats), so that the labels of a pixel,
+// which a path reads and writes together, share cache lines; offset, weight are H * W.
 // value(p, l) = offset[p] + l * step. weight[e] is the edge weight of this direction's edge
 // type, indexed by the edge's upper (horizontal edges: left) pixel e.
 //
@@ -35,7 +36,6 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
     col = dx > 0 ? 0 : width - 1;
     row = dy > 0 ? j : height - 1 - j;
   }
-  const int n = width * height;
   float prev[NUM_LABELS];
   float cur[NUM_LABELS];
   float m[NUM_LABELS];
@@ -43,9 +43,9 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
   float prev_min = INFINITY;
 #pragma unroll
   for (int b = 0; b < NUM_LABELS; ++b) {
-    prev[b] = cost[b * n + p];
+    prev[b] = cost[p * NUM_LABELS + b];
     prev_min = fmin(prev_min, prev[b]);
-    sum[b * n + p] += prev[b];
+    sum[p * NUM_LABELS + b] += prev[b];
   }
   float prev_offset = offset[p];
   const int upper_is_prev = dy > 0 || (dy == 0 && dx > 0);
@@ -60,13 +60,13 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
     mrf_path_min(prev, prev_min, step, cur_offset - prev_offset, w, truncation, m);
     float cur_min = INFINITY;
     for (int b = 0; b < NUM_LABELS; ++b) {
-      cur[b] = cost[b * n + p] + (m[b] - prev_min);
+      cur[b] = cost[p * NUM_LABELS + b] + (m[b] - prev_min);
       cur_min = fmin(cur_min, cur[b]);
     }
 #pragma unroll
     for (int b = 0; b < NUM_LABELS; ++b) {
       prev[b] = cur[b];
-      sum[b * n + p] += cur[b];
+      sum[p * NUM_LABELS + b] += cur[b];
     }
     prev_min = cur_min;
     prev_offset = cur_offset;
@@ -76,10 +76,10 @@ __kernel void sgm_path(__global const float* cost, __global const float* offset,
 __kernel void sgm_argmin(__global const float* sum, int num_pixels, __global int* labels) {
   const int p = get_global_id(0);
   if (p >= num_pixels) return;
-  float best = sum[p];
+  float best = sum[p * NUM_LABELS];
   int best_label = 0;
   for (int b = 1; b < NUM_LABELS; ++b) {
-    const float s = sum[b * num_pixels + p];
+    const float s = sum[p * NUM_LABELS + b];
     if (s < best) {
       best = s;
       best_label = b;

@@ -107,6 +107,12 @@ struct OrientationStereoOptions {
   // a band of fine labels around the upsampled coarse depth at full resolution. -1: single stage
   // (full range at full resolution).
   int coarse_level = 2;
+  // The finest pyramid level in the coarse stage's data term (0: all levels, as the fine stage);
+  // the levels used count for the ones left out. The all-label cost volume of level 0 is most
+  // of the stereo's work: 1 on a synthesised 4-view set at 1404 x 936 took the time per
+  // finished view from 24.2 to 14.9 s, but the per-pixel median from 6.10 to 7.27 mm (90.9 ->
+  // 89.0% complete).
+  int coarse_first_level = 0;
   int fine_num_labels = 16;
   double fine_label_step = 0.5;  // in coarse labels
   // Depth slices per kernel launch (memory vs launch overhead).
@@ -201,6 +207,8 @@ struct OrientationStereoOptions {
     v("mrf_max_cycles", &mrf_max_cycles, "MRF solver cycles / iterations");
     v("coarse_level", &coarse_level,
       "orientation level whose grid the full-range MRF uses (-1: single stage at full size)");
+    v("coarse_first_level", &coarse_first_level,
+      "finest pyramid level in the coarse stage's data term (0: all)");
     v("fine_num_labels", &fine_num_labels, "labels of the fine band around the coarse depth");
     v("fine_label_step", &fine_label_step, "fine label spacing in coarse labels");
     v("slice_block", &slice_block, "depth slices per kernel launch");

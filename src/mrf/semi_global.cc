@@ -220,7 +220,16 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
   cl::Kernel path_kernel(program, "sgm_path");
   cl::Kernel argmin_kernel(program, "sgm_argmin");
 
-  cl::Buffer cost_buffer = MrfReadOnlyBuffer(ctx, problem.data_cost);
+  // The paths read and write all labels of a pixel at once: pixel-major on the device.
+  cl::Buffer cost_buffer;
+  {
+    std::vector<float> cost_by_pixel(n * num_labels);
+    for (int b = 0; b < num_labels; ++b) {
+      const float* slice = problem.data_cost.data() + b * n;
+      for (size_t p = 0; p < n; ++p) cost_by_pixel[p * num_labels + b] = slice[p];
+    }
+    cost_buffer = MrfReadOnlyBuffer(ctx, cost_by_pixel);
+  }
   cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
   cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, n * num_labels * sizeof(float));
   cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
@@ -255,7 +264,9 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
 
   if (icm_iterations > 0) {
     // weight_buffers[0], [2]: directions (1, 0) and (0, 1), i.e. weights.right and .down.
-    RunIcmOpenCL(context, cost_buffer, offset_buffer, weight_buffers[0], weight_buffers[2],
+    // ICM reads label-major costs, as MrfProblem holds them.
+    const cl::Buffer label_major_cost = MrfReadOnlyBuffer(ctx, problem.data_cost);
+    RunIcmOpenCL(context, label_major_cost, offset_buffer, weight_buffers[0], weight_buffers[2],
                  problem, icm_iterations, label_buffer);
   }
   return MrfReadLabels(queue, label_buffer, n);

@@ -275,7 +275,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
 
   // The aggregated data term summed over levels on the grid of `grid_level`:
   // [label][row][col] for num_labels labels v = base_l(p) + k * step.
-  auto build_volume = [&](int grid_level, int num_labels,
+  auto build_volume = [&](int grid_level, int first_level, int num_labels,
                           const std::vector<std::vector<float>>& base, float step) {
     const int gw = levels[grid_level].width, gh = levels[grid_level].height;
     const size_t grid_pixels = static_cast<size_t>(gw) * gh;
@@ -283,17 +283,25 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     cl::Buffer volume(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * host.size());
     queue.enqueueFillBuffer(volume, 0.0f, 0, sizeof(float) * host.size());
     const int block = std::max(1, std::min(options.slice_block, num_labels));
+    // Without the finest levels, the others count for them, so that the data term keeps its
+    // scale against lambda.
+    const float level_weight = static_cast<float>(num_levels) / (num_levels - first_level);
     std::vector<cl::Buffer> base_buffers, blocks;
     for (int l = 0; l < num_levels; ++l) {
       const size_t n = static_cast<size_t>(levels[l].width) * levels[l].height;
       CHECK_EQ(base[l].size(), n);
+      if (l < first_level) {  // unused: no buffers
+        base_buffers.emplace_back();
+        blocks.emplace_back();
+        continue;
+      }
       base_buffers.emplace_back(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                 sizeof(float) * n, const_cast<float*>(base[l].data()));
       blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
     }
     for (int s0 = 0; s0 < num_labels; s0 += block) {
       const int ns = std::min(block, num_labels - s0);
-      for (int l = 0; l < num_levels; ++l) {
+      for (int l = first_level; l < num_levels; ++l) {
         {
           ScopedStageTimer timer(timings, "cost volume");
           levels[l].cost->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
@@ -301,7 +309,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         }
         ScopedStageTimer timer(timings, "aggregation");
         levels[l].filter->Filter(blocks[l], ns, blocks[l]);
-        resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0, 1.0f);
+        resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0,
+                     level_weight);
         queue.finish();
       }
     }
@@ -335,6 +344,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const int num_depths = labels.num_labels;
   const bool two_stage = options.coarse_level > 0 && num_levels > 1;
   const int coarse_level = two_stage ? std::min(options.coarse_level, num_levels - 1) : 0;
+  const int coarse_first_level = two_stage ? options.coarse_first_level : 0;
 
   // Coarse stage: every label, on the coarse grid.
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
@@ -348,7 +358,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
     coarse_volume = *coarse_volume_cache;
   } else {
-    coarse_volume = build_volume(coarse_level, num_depths, zero_base, 1.0f);
+    coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
+                                 num_depths, zero_base, 1.0f);
     if (coarse_volume_cache != nullptr) *coarse_volume_cache = coarse_volume;
   }
   const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
@@ -435,7 +446,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
       }
     }
     if (progress != nullptr) progress->Stage("cost volume and aggregation (fine band)");
-    std::vector<float> fine_volume = build_volume(0, band, base, step);
+    std::vector<float> fine_volume = build_volume(0, 0, band, base, step);
     if (use_prior) {
       ScopedStageTimer timer(timings, "geometric prior");
       AddGeometricPrior(*prior, ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step,

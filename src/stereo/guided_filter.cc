@@ -33,7 +33,9 @@ void BoxFilterCL::Mean(const cl::Buffer& in, const cl::Buffer& scratch, const cl
   cols_.setArg(2, width);
   cols_.setArg(3, height);
   cols_.setArg(4, radius);
-  context_->Queue().enqueueNDRangeKernel(cols_, cl::NullRange, cl::NDRange(width, num_planes));
+  // box_cols: a work-item per 8 columns.
+  context_->Queue().enqueueNDRangeKernel(cols_, cl::NullRange,
+                                         cl::NDRange((width + 7) / 8, num_planes));
 }
 
 GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, int radius,

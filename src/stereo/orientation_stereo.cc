@@ -146,6 +146,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
   if (coarse_level < -1) e << "coarse_level must be >= -1; ";
+  if (coarse_first_level < 0) e << "coarse_first_level must be >= 0; ";
   if (fine_num_labels < 3) e << "fine_num_labels must be >= 3; ";
   if (!(fine_label_step > 0)) e << "fine_label_step must be > 0; ";
   if (slice_block < 1) e << "slice_block must be >= 1; ";
