@@ -9,7 +9,8 @@
 // view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), 0, 0 with
 // psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5.
 // view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
-// Orientation fields are planar: Re plane then Im plane (width * height each).
+// The reference orientation field is planar (Re plane, then Im plane); the source fields are
+// interleaved (Re, Im per pixel), since they are sampled at scattered points.
 // cost: [k][row][col] for k in [0, num_slices).
 
 inline float SampleDepth(float v, float depth_a, float depth_b, int inverse_depth) {
@@ -17,10 +18,11 @@ inline float SampleDepth(float v, float depth_a, float depth_b, int inverse_dept
   return inverse_depth ? 1.0f / t : t;
 }
 
-// Bilinear sample of two planes at pixel coordinates (x, y) (pixel centres at integers).
-// Returns 0 (and valid = 0) outside [0, w-1] x [0, h-1].
-inline float2 Bilinear2(__global const float* plane0, __global const float* plane1, int w,
-                        int h, float x, float y, int* valid) {
+// Bilinear sample of an interleaved 2-channel field (Re, Im per pixel) at pixel coordinates
+// (x, y) (pixel centres at integers): a sample reads 2 to 4 cache lines rather than twice that
+// from two planes. Returns 0 (and valid = 0) outside [0, w-1] x [0, h-1].
+inline float2 Bilinear2(__global const float* field, int w, int h, float x, float y,
+                        int* valid) {
   if (!(x >= 0.0f && y >= 0.0f && x <= (float)(w - 1) && y <= (float)(h - 1))) {
     *valid = 0;
     return (float2)(0.0f, 0.0f);
@@ -32,12 +34,13 @@ inline float2 Bilinear2(__global const float* plane0, __global const float* plan
   const int y1 = min(y0 + 1, h - 1);
   const float fx = x - (float)x0;
   const float fy = y - (float)y0;
-  const int i00 = y0 * w + x0, i01 = y0 * w + x1, i10 = y1 * w + x0, i11 = y1 * w + x1;
+  const float2 v00 = vload2(y0 * w + x0, field), v01 = vload2(y0 * w + x1, field);
+  const float2 v10 = vload2(y1 * w + x0, field), v11 = vload2(y1 * w + x1, field);
   const float w00 = (1.0f - fx) * (1.0f - fy), w01 = fx * (1.0f - fy);
   const float w10 = (1.0f - fx) * fy, w11 = fx * fy;
   float2 r;
-  r.x = w00 * plane0[i00] + w01 * plane0[i01] + w10 * plane0[i10] + w11 * plane0[i11];
-  r.y = w00 * plane1[i00] + w01 * plane1[i01] + w10 * plane1[i10] + w11 * plane1[i11];
+  r.x = w00 * v00.x + w01 * v01.x + w10 * v10.x + w11 * v11.x;
+  r.y = w00 * v00.y + w01 * v01.y + w10 * v10.y + w11 * v11.y;
   return r;
 }
 
@@ -83,7 +86,7 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
       const int h = view_dims[4 * j + 1];
       __global const float* src = source + view_dims[4 * j + 2];
       int valid;
-      const float2 o = Bilinear2(src, src + w * h, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
+      const float2 o = Bilinear2(src, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
       if (!valid) continue;
       // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
       const float re = ore * o.x + oim * o.y;

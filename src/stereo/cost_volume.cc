@@ -69,7 +69,16 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     params.insert(params.end(), packed.begin(), packed.end());
     dims.insert(dims.end(), {src.field.Width(), src.field.Height(),
                              static_cast<int>(all_sources.size()), 0});
-    all_sources.insert(all_sources.end(), src.field.Data().begin(), src.field.Data().end());
+    if (cost == StereoCost::kOrientation) {  // interleaved, as orientation_cost samples it
+      const float* re = src.field.Channel(0);
+      const float* im = src.field.Channel(1);
+      const size_t offset = all_sources.size();
+      all_sources.resize(offset + 2 * src.field.NumPixels());
+      for (size_t p = 0; p < src.field.NumPixels(); ++p) {
+        all_sources[offset + 2 * p] = re[p];
+        all_sources[offset + 2 * p + 1] = im[p];
+      }
+    }
     source_sizes_.push_back({src.field.Width(), src.field.Height()});
     if (cost == StereoCost::kPhotometric) {
       source_buffers_.push_back(
