@@ -109,8 +109,8 @@ struct OrientationStereoOptions {
   int coarse_level = 2;
   // The finest pyramid level in the coarse stage's data term (0: all levels, as the fine stage);
   // the levels used count for the ones left out. The all-label cost volume of level 0 is most
-  // of the stereo's work: 1 on a synthesised 4-view set at 1404 x 936 took the time per
-  // finished view from 24.2 to 14.9 s, but the per-pixel median from 6.10 to 7.27 mm (90.9 ->
+  // of the coarse stage's work: 1 on a synthesised 4-view set at 1404 x 936 takes the time per
+  // finished view from 17.3 to 13.1 s, but the per-pixel median from 6.10 to 7.27 mm (90.9 ->
   // 89.0% complete).
   int coarse_first_level = 0;
   int fine_num_labels = 16;
@@ -161,7 +161,8 @@ struct OrientationStereoOptions {
   // 95.1% of the hair pixels at a per-pixel median of 4.79 / 4.80 / 4.82 / 4.89 mm; the
   // synthesised curly T group (seed 1), 0 / 1: 92.3 / 96.7% at 2.37 / 2.36 mm (mean 3.90 /
   // 3.71). Every view is estimated twice; with the coarse volumes kept between the estimates
-  // the stereo takes about 1.6x as long (32 gantry views: 315 s, 186 s without the prior).
+  // the geometric pass takes under half as long as the first (32 gantry views: 159.5 s, then
+  // 70.4 s).
   double geom_prior_weight = 1.0;
   double geom_prior_max_error_px = 3.0;
   // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
