@@ -217,54 +217,57 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
   cl::CommandQueue& queue = context->Queue();
   cl::Program& program =
       context->Program({"mrf_sgm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
-  cl::Kernel path_kernel(program, "sgm_path");
-  cl::Kernel argmin_kernel(program, "sgm_argmin");
-
-  // The paths read and write all labels of a pixel at once: pixel-major on the device.
-  cl::Buffer cost_buffer;
+  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
+  cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
+  // Each direction's weight buffer stays alive until the queue has finished with it; [0] and
+  // [2], directions (1, 0) and (0, 1), are weights.right and .down, which ICM reads too.
+  std::vector<cl::Buffer> weight_buffers;
   {
-    std::vector<float> cost_by_pixel(n * num_labels);
+    // The paths read and write all labels of a pixel at once: the costs and sums are
+    // pixel-major on the device, the costs written transposed straight into the mapped buffer
+    // (no second host copy of the volume).
+    const size_t volume_bytes = n * num_labels * sizeof(float);
+    cl::Buffer cost_buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, volume_bytes);
+    float* cost_by_pixel = static_cast<float*>(queue.enqueueMapBuffer(
+        cost_buffer, CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0, volume_bytes));
     for (int b = 0; b < num_labels; ++b) {
       const float* slice = problem.data_cost.data() + b * n;
       for (size_t p = 0; p < n; ++p) cost_by_pixel[p * num_labels + b] = slice[p];
     }
-    cost_buffer = MrfReadOnlyBuffer(ctx, cost_by_pixel);
-  }
-  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
-  cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, n * num_labels * sizeof(float));
-  cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
-  queue.enqueueFillBuffer(sum_buffer, 0.0f, 0, n * num_labels * sizeof(float));
-
-  // Keep each direction's weight buffer alive until the queue has finished with it.
-  std::vector<cl::Buffer> weight_buffers;
-  for (const auto& dir : SemiGlobalDirections(num_directions)) {
-    const int dx = dir[0];
-    const int dy = dir[1];
-    weight_buffers.push_back(MrfReadOnlyBuffer(ctx, DirectionWeights(weights, dx, dy)));
-    const int num_paths = NumPaths(width, height, dx, dy);
-    path_kernel.setArg(0, cost_buffer);
-    path_kernel.setArg(1, offset_buffer);
-    path_kernel.setArg(2, problem.label_step);
-    path_kernel.setArg(3, weight_buffers.back());
-    path_kernel.setArg(4, FiniteTruncation(problem));
-    path_kernel.setArg(5, width);
-    path_kernel.setArg(6, height);
-    path_kernel.setArg(7, dx);
-    path_kernel.setArg(8, dy);
-    path_kernel.setArg(9, num_paths);
-    path_kernel.setArg(10, sum_buffer);
-    queue.enqueueNDRangeKernel(path_kernel, cl::NullRange, MrfGlobalRange(num_paths),
+    queue.enqueueUnmapMemObject(cost_buffer, cost_by_pixel);
+    cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, volume_bytes);
+    queue.enqueueFillBuffer(sum_buffer, 0.0f, 0, volume_bytes);
+    cl::Kernel path_kernel(program, "sgm_path");
+    cl::Kernel argmin_kernel(program, "sgm_argmin");
+    for (const auto& dir : SemiGlobalDirections(num_directions)) {
+      const int dx = dir[0];
+      const int dy = dir[1];
+      weight_buffers.push_back(MrfReadOnlyBuffer(ctx, DirectionWeights(weights, dx, dy)));
+      const int num_paths = NumPaths(width, height, dx, dy);
+      path_kernel.setArg(0, cost_buffer);
+      path_kernel.setArg(1, offset_buffer);
+      path_kernel.setArg(2, problem.label_step);
+      path_kernel.setArg(3, weight_buffers.back());
+      path_kernel.setArg(4, FiniteTruncation(problem));
+      path_kernel.setArg(5, width);
+      path_kernel.setArg(6, height);
+      path_kernel.setArg(7, dx);
+      path_kernel.setArg(8, dy);
+      path_kernel.setArg(9, num_paths);
+      path_kernel.setArg(10, sum_buffer);
+      queue.enqueueNDRangeKernel(path_kernel, cl::NullRange, MrfGlobalRange(num_paths),
+                                 cl::NDRange(kMrfLocalSize));
+    }
+    argmin_kernel.setArg(0, sum_buffer);
+    argmin_kernel.setArg(1, static_cast<int>(n));
+    argmin_kernel.setArg(2, label_buffer);
+    queue.enqueueNDRangeKernel(argmin_kernel, cl::NullRange, MrfGlobalRange(n),
                                cl::NDRange(kMrfLocalSize));
+    // Done with the pixel-major volumes before ICM uploads its label-major one.
+    queue.finish();
   }
-  argmin_kernel.setArg(0, sum_buffer);
-  argmin_kernel.setArg(1, static_cast<int>(n));
-  argmin_kernel.setArg(2, label_buffer);
-  queue.enqueueNDRangeKernel(argmin_kernel, cl::NullRange, MrfGlobalRange(n),
-                             cl::NDRange(kMrfLocalSize));
 
   if (icm_iterations > 0) {
-    // weight_buffers[0], [2]: directions (1, 0) and (0, 1), i.e. weights.right and .down.
-    // ICM reads label-major costs, as MrfProblem holds them.
     const cl::Buffer label_major_cost = MrfReadOnlyBuffer(ctx, problem.data_cost);
     RunIcmOpenCL(context, label_major_cost, offset_buffer, weight_buffers[0], weight_buffers[2],
                  problem, icm_iterations, label_buffer);
