@@ -161,8 +161,8 @@ struct OrientationStereoOptions {
   // 95.1% of the hair pixels at a per-pixel median of 4.79 / 4.80 / 4.82 / 4.89 mm; the
   // synthesised curly T group (seed 1), 0 / 1: 92.3 / 96.7% at 2.37 / 2.36 mm (mean 3.90 /
   // 3.71). Every view is estimated twice; with the coarse volumes kept between the estimates
-  // the geometric pass takes under half as long as the first (32 gantry views: 159.5 s, then
-  // 70.4 s).
+  // the geometric pass takes under half as long as the first (32 gantry views: 143.2 s, then
+  // 69.8 s).
   double geom_prior_weight = 1.0;
   double geom_prior_max_error_px = 3.0;
   // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
