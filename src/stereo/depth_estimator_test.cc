@@ -122,6 +122,24 @@ TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
   EXPECT_GT(result.completeness, 0.8);
 }
 
+// The coarse stage without level 0 (coarse_first_level 1, a speed option) still finds the
+// plane: the fine stage, with every level, refines what the coarser levels located.
+TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  OrientationStereoOptions options = TestOptions();
+  options.coarse_first_level = 1;
+  const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
+  const Result all_levels = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
+  std::printf("plane, coarse stage from level 1: median |error| %.4f m (all levels %.4f m), "
+              "completeness %.3f\n",
+              result.median_abs_error_m, all_levels.median_abs_error_m, result.completeness);
+  EXPECT_LT(result.median_abs_error_m, 0.01);
+  EXPECT_GT(result.completeness, 0.8);
+  EXPECT_NE(result.median_abs_error_m, all_levels.median_abs_error_m);  // level 0 was left out
+}
+
 TEST(DepthEstimator, RecoversASphereCoveredInStrands) {
   Surface sphere;
   sphere.sphere = true;
