@@ -74,6 +74,7 @@ MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
   THROW_IF(!FromString(options.mrf_solver, &mrf.solver),
            "--OrientationStereo.mrf_solver: unknown solver '" << options.mrf_solver << "'");
   mrf.max_cycles = options.mrf_max_cycles;
+  mrf.icm_polish_iterations = options.mrf_icm_polish_iterations;
   return mrf;
 }
 

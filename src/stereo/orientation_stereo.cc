@@ -145,6 +145,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(lambda >= 0)) e << "lambda must be >= 0; ";
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
+  if (mrf_icm_polish_iterations < 0) e << "mrf_icm_polish_iterations must be >= 0; ";
   if (coarse_level < -1) e << "coarse_level must be >= -1; ";
   if (coarse_first_level < 0) e << "coarse_first_level must be >= 0; ";
   if (fine_num_labels < 3) e << "fine_num_labels must be >= 3; ";
