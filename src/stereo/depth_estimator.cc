@@ -357,7 +357,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const size_t coarse_size = static_cast<size_t>(cw) * ch * num_depths;
   std::vector<float> coarse_volume;
   if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
-    coarse_volume = *coarse_volume_cache;
+    // Moved out, not copied: the geometric pass is the volume's last use.
+    coarse_volume = std::move(*coarse_volume_cache);
+    coarse_volume_cache->clear();
   } else {
     coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
                                  num_depths, zero_base, 1.0f);

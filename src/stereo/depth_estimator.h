@@ -64,9 +64,9 @@ void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_cam
                        float cost_scale, std::vector<float>* volume);
 
 // `coarse_volume_cache` (may be null): the coarse stage's aggregated data term, before any
-// prior or bound, which depends only on the views, labels and options; used when it holds a
-// volume of the coarse grid's size, filled when empty (the geometric pass estimates each view
-// again from the same data: the all-label volume is most of an estimate's work).
+// prior or bound, which depends only on the views, labels and options; used (and emptied) when
+// it holds a volume of the coarse grid's size, filled when empty (the geometric pass estimates
+// each view again from the same data: the all-label volume is most of an estimate's work).
 // `depth_lower_bound` (level-0 grid, metres, 0 = none; may be empty), per
 // options.visual_hull_depth_bound: kFilter, depths that end in front of it are invalid (0);
 // kPenalty, labels in front of it get the pixel's worst cost plus one cost range per label of
