@@ -113,10 +113,16 @@ std::vector<StereoCamera> TCameras(const Eigen::Vector3d& target, double roll_ra
           LookAtCamera({0, -0.3, 0}, target, 100, 96, 72)};
 }
 
-TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
+// A plane 1 m in front of the reference, turned 0.35 rad about the vertical.
+Surface TiltedPlane() {
   Surface plane;
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  return plane;
+}
+
+TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
+  const Surface plane = TiltedPlane();
   const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
   std::printf("plane: median |error| %.4f m, completeness %.3f\n", result.median_abs_error_m,
               result.completeness);
@@ -127,9 +133,7 @@ TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
 // The coarse stage without level 0 (coarse_first_level 1, a speed option) still finds the
 // plane: the fine stage, with every level, refines what the coarser levels located.
 TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
-  Surface plane;
-  plane.point = {0, 0, 1};
-  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const Surface plane = TiltedPlane();
   OrientationStereoOptions options = TestOptions();
   options.coarse_first_level = 1;
   const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
@@ -145,9 +149,7 @@ TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
 // --OrientationStereo.mrf_icm_polish_iterations reaches the solver: without the ICM polish
 // the semi-global labels keep a higher energy, and the plane is still recovered.
 TEST(DepthEstimator, IcmPolishLowersTheEnergyOfTheSemiGlobalLabels) {
-  Surface plane;
-  plane.point = {0, 0, 1};
-  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const Surface plane = TiltedPlane();
   OrientationStereoOptions options = TestOptions();
   options.mrf_icm_polish_iterations = 0;
   const Result without = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
