@@ -25,8 +25,8 @@ namespace {
 
 using namespace testing_util;
 
-// Writes the workspace; returns the true depth of view 0 (of every view in `true_depths`).
-FloatMap WriteWorkspace(const std::string& path, std::vector<FloatMap>* true_depths = nullptr) {
+// Writes the workspace; returns the true depth map of every view (v0, v1, v2, v3).
+std::vector<FloatMap> WriteWorkspace(const std::string& path) {
   Surface plane;
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.3), 0, -std::cos(0.3));
@@ -44,12 +44,11 @@ FloatMap WriteWorkspace(const std::string& path, std::vector<FloatMap>* true_dep
   camera.height = 72;
   camera.params = {100, 100, 48, 36};
   model.cameras[1] = camera;
-  FloatMap true_depth;
+  std::vector<FloatMap> true_depths;
   CreateDirs(JoinPaths(path, "images"));
   for (size_t i = 0; i < cameras.size(); ++i) {
     const RenderedView view = RenderView(cameras[i], plane, strands);
-    if (i == 0) true_depth = view.depth;
-    if (true_depths != nullptr) true_depths->push_back(view.depth);
+    true_depths.push_back(view.depth);
     Image image;
     image.image_id = static_cast<uint32_t>(i + 1);
     image.camera_id = 1;
@@ -81,7 +80,7 @@ FloatMap WriteWorkspace(const std::string& path, std::vector<FloatMap>* true_dep
     }
     cfg << "\n";
   }
-  return true_depth;
+  return true_depths;
 }
 
 // The plane of WriteWorkspace lies within this depth range; its 96 x 72 views need only one
@@ -98,7 +97,7 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   const std::string path =
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_workspace_test").string();
   std::filesystem::remove_all(path);
-  const FloatMap true_depth = WriteWorkspace(path);
+  const FloatMap true_depth = WriteWorkspace(path)[0];
   OrientationStereoOptions options = PlaneOptions();
   options.write_png = true;
   StageTimings timings;
@@ -164,7 +163,7 @@ TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhoto
   const std::string path =
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_consistency_test").string();
   std::filesystem::remove_all(path);
-  const FloatMap true_depth = WriteWorkspace(path);
+  const FloatMap true_depth = WriteWorkspace(path)[0];
   OrientationStereoOptions options = PlaneOptions();
   options.geom_prior_weight = 0;  // the filter alone
   StageTimings timings;
@@ -215,8 +214,7 @@ TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAs
   const std::string path =
       (std::filesystem::temp_directory_path() / "hairmvs_stereo_prior_test").string();
   std::filesystem::remove_all(path);
-  std::vector<FloatMap> true_depths;
-  WriteWorkspace(path, &true_depths);
+  const std::vector<FloatMap> true_depths = WriteWorkspace(path);
   const std::vector<std::string> names = {"v0.png", "v1.png", "v2.png", "v3.png"};
   OrientationStereoOptions options = PlaneOptions();
   StageTimings timings;
