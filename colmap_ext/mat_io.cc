@@ -1,6 +1,8 @@
 #include "colmap_ext/mat_io.h"
 
+#include <cstdlib>
 #include <cstring>
+#include <iomanip>
 #include <fstream>
 #include <limits>
 
@@ -18,8 +20,9 @@ FloatMap ReadMat(std::istream& in, const std::string& source) {
   in >> width >> sep1 >> height >> sep2 >> channels >> sep3;
   THROW_IF(!in || sep1 != '&' || sep2 != '&' || sep3 != '&',
            source << ": not a COLMAP Mat file (expected a header \"W&H&C&\")");
+  // Cost volumes have a channel per depth label (hundreds); more than 4096 is a broken header.
   THROW_IF(width <= 0 || height <= 0 || channels <= 0 || width > (1 << 16) ||
-               height > (1 << 16) || channels > 64,
+               height > (1 << 16) || channels > 4096,
            source << ": invalid Mat dimensions " << width << "x" << height << "x" << channels);
   FloatMap map(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels));
   const std::streamsize num_bytes =
@@ -50,6 +53,40 @@ void WriteMat(std::ostream& out, const FloatMap& map) {
 
 void WriteMat(const std::string& path, const FloatMap& map) {
   WriteFileAtomically(path, [&map](std::ostream& out) { WriteMat(out, map); });
+}
+
+CostVolume ReadCostVolume(const std::string& path, const std::string& depths_path) {
+  CostVolume volume;
+  volume.cost = ReadMat(path);
+  RequireFile(depths_path, "label depths of " + path);
+  const std::vector<std::string> lines = ReadLines(depths_path);
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::string line = StripWhitespace(lines[i]);
+    if (line.empty() || line[0] == '#') continue;
+    char* end = nullptr;
+    const double depth = std::strtod(line.c_str(), &end);
+    THROW_IF(end == line.c_str() || *end != '\0' || !(depth > 0),
+             depths_path << ":" << i + 1 << ": not a positive depth: '" << line << "'");
+    volume.label_depths.push_back(depth);
+  }
+  THROW_IF(static_cast<int>(volume.label_depths.size()) != volume.cost.Channels(),
+           depths_path << ": " << volume.label_depths.size() << " depths for the "
+                       << volume.cost.Channels() << " labels of " << path);
+  return volume;
+}
+
+void WriteCostVolume(const std::string& path, const std::string& depths_path,
+                     const CostVolume& volume) {
+  CHECK_EQ(static_cast<int>(volume.label_depths.size()), volume.cost.Channels());
+  WriteMat(path, volume.cost);
+  WriteFileAtomically(
+      depths_path,
+      [&volume](std::ostream& out) {
+        out << "# depth (m) of each label (channel) of the cost volume, one per line\n"
+            << std::setprecision(9);
+        for (const double depth : volume.label_depths) out << depth << "\n";
+      },
+      false);
 }
 
 }  // namespace hairmvs

@@ -6,6 +6,7 @@
 #include <istream>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include "src/core/float_map.h"
 
@@ -18,5 +19,19 @@ FloatMap ReadMat(std::istream& in, const std::string& source);
 // Writes atomically (temporary name, then rename).
 void WriteMat(const std::string& path, const FloatMap& map);
 void WriteMat(std::ostream& out, const FloatMap& map);
+
+// A depth-label cost volume: a Mat with one channel per label ([label][row][col]) at
+// `path`, and the labels' depths in metres, one per line ('#' lines are comments), at
+// `depths_path`. hairmvs writes stereo/cost_volumes/<name>.coarse.bin and .coarse.depths.txt.
+struct CostVolume {
+  FloatMap cost;
+  std::vector<double> label_depths;
+};
+// Throws hairmvs::Error naming the file for: a missing file, a malformed Mat, a line that is
+// not a positive number, or a number of depths other than the Mat's channels.
+CostVolume ReadCostVolume(const std::string& path, const std::string& depths_path);
+// Writes both files atomically. CHECKs that there is one depth per channel.
+void WriteCostVolume(const std::string& path, const std::string& depths_path,
+                     const CostVolume& volume);
 
 }  // namespace hairmvs

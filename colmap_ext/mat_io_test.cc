@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
+#include "src/core/file_util.h"
 #include "src/core/logging.h"
 
 namespace hairmvs {
@@ -42,6 +45,40 @@ TEST(MatIo, BadInput) {
   std::istringstream zero("0&4&1&");
   EXPECT_THROW(ReadMat(zero, "d.bin"), Error);
   EXPECT_THROW(ReadMat("/nonexistent/d.bin"), Error);
+}
+
+TEST(MatIo, CostVolumeRoundTripAndBadDepths) {
+  const std::string dir =
+      (std::filesystem::temp_directory_path() / "hairmvs_cost_volume_io_test").string();
+  std::filesystem::remove_all(dir);
+  CostVolume volume;
+  volume.cost = FloatMap(4, 3, 200);  // more labels than image channels ever have
+  for (size_t i = 0; i < volume.cost.Data().size(); ++i) volume.cost.Data()[i] = 0.25f * i;
+  for (int k = 0; k < 200; ++k) volume.label_depths.push_back(0.4 + 0.001 * k);
+  const std::string path = JoinPaths(dir, "v.coarse.bin");
+  const std::string depths = JoinPaths(dir, "v.coarse.depths.txt");
+  WriteCostVolume(path, depths, volume);
+  const CostVolume read = ReadCostVolume(path, depths);
+  EXPECT_EQ(read.cost.Channels(), 200);
+  EXPECT_EQ(read.cost.Data(), volume.cost.Data());
+  ASSERT_EQ(read.label_depths.size(), 200u);
+  for (int k = 0; k < 200; ++k) EXPECT_NEAR(read.label_depths[k], volume.label_depths[k], 1e-9);
+
+  auto expect_error = [&](const std::string& text, const std::string& what) {
+    std::ofstream(depths) << text;
+    try {
+      ReadCostVolume(path, depths);
+      ADD_FAILURE() << "no error for " << what;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(depths), std::string::npos) << e.what();
+    }
+  };
+  expect_error("0.5\n0.6\n", "too few depths");
+  expect_error("0.5\nfar\n", "a word");
+  expect_error("-0.5\n", "a negative depth");
+  std::filesystem::remove(depths);
+  EXPECT_THROW(ReadCostVolume(path, depths), Error);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

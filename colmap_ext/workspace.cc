@@ -103,6 +103,14 @@ std::string Workspace::ConfidenceMapPath(const std::string& name) const {
   return JoinPaths(StereoPath(), "confidence_maps", name + ".bin");
 }
 
+std::string Workspace::CostVolumePath(const std::string& name) const {
+  return JoinPaths(StereoPath(), "cost_volumes", name + ".coarse.bin");
+}
+
+std::string Workspace::CostVolumeDepthsPath(const std::string& name) const {
+  return JoinPaths(StereoPath(), "cost_volumes", name + ".coarse.depths.txt");
+}
+
 std::string Workspace::OrientationMapPath(const std::string& name, int level) const {
   CHECK_GE(level, 0);
   return JoinPaths(StereoPath(), "orientation_maps",

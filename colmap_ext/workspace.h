@@ -36,6 +36,9 @@ class Workspace {
   std::string DepthMapPath(const std::string& name, const std::string& type = "geometric") const;
   std::string NormalMapPath(const std::string& name, const std::string& type = "geometric") const;
   std::string ConfidenceMapPath(const std::string& name) const;
+  // The coarse data term (--OrientationStereo.write_cost_volume) and its labels' depths.
+  std::string CostVolumePath(const std::string& name) const;
+  std::string CostVolumeDepthsPath(const std::string& name) const;
   std::string OrientationMapPath(const std::string& name, int level) const;
 
  private:

@@ -124,6 +124,54 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
                                         const DepthEvaluationOptions& options);
 
+// The data term alone, without the MRF: per coarse pixel of a view's cost volume as
+// `orientation_stereo --OrientationStereo.write_cost_volume 1` writes it, where its cheapest
+// label lies against the true depth (the median true depth of the hair pixels the coarse pixel
+// covers). Compares costs (orientation vs photometric) on what they bring, before smoothing.
+struct DataTermEvaluationOptions {
+  // Empty: every image of the workspace that has a cost volume.
+  std::vector<std::string> image_names;
+  // A coarse pixel counts when at least this fraction of the image pixels it covers are hair.
+  double min_hair_fraction = 0.5;
+  // The JSON goes here; empty = <workspace>/stereo/evaluation.
+  std::string output_path;
+
+  template <typename Visitor>
+  void ForEachField(Visitor&& v) {
+    v("image_names", &image_names, "views to evaluate (comma-separated; empty = all)");
+    v("min_hair_fraction", &min_hair_fraction,
+      "count a coarse pixel when at least this fraction of its image pixels are hair");
+    v("output_path", &output_path, "folder for the JSON (default W/stereo/evaluation)");
+  }
+  bool Check(std::string* error) const;
+};
+
+struct DataTermMetrics {
+  std::string name;  // image name, or "overall"
+  long num_pixels = 0;          // coarse hair pixels whose true depth is inside the label range
+  long num_outside_range = 0;   // coarse hair pixels whose true depth is outside it
+  double label_step_mm = 0;     // median depth step between the labels around the true depths
+  // |depth of the cheapest label - true depth|.
+  double median_abs_error_mm = 0;
+  double within_1_label = 0;  // fractions of num_pixels: cheapest label within 1 label
+  double within_5mm = 0;
+  double within_10mm = 0;
+  // Median over the pixels of the fraction of labels cheaper than the true depth (its cost
+  // interpolated between the two labels around it): 0 = the truth is the data term's minimum.
+  double median_true_depth_rank = 0;
+};
+
+struct DataTermEvaluationResult {
+  std::vector<DataTermMetrics> views;
+  DataTermMetrics overall;  // pooled over all views' pixels
+  std::string json_path;
+  std::string Table() const;
+};
+
+DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
+                                          const std::string& ground_truth_path,
+                                          const DataTermEvaluationOptions& options);
+
 struct MeshEvaluationOptions {
   // Accuracy also from points sampled on the faces, about this far apart (0 = vertices only).
   double face_sample_spacing_m = 5e-4;

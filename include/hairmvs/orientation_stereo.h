@@ -182,6 +182,12 @@ struct OrientationStereoOptions {
   bool reuse_orientation_maps = true;
   bool write_orientation_maps = true;
   bool write_png = false;
+  // Also write each view's coarse data term as first estimated (aggregated, all labels, before
+  // the geometric prior and the hull bound) to stereo/cost_volumes/<name>.coarse.bin (a Mat on
+  // the coarse grid, one channel per depth label) and the labels' depths to
+  // <name>.coarse.depths.txt, for `hairmvs evaluate_data_term`: how often the data term alone
+  // finds the true depth, whatever the MRF makes of it. About 20 MiB a view at 960 x 640.
+  bool write_cost_volume = false;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -250,6 +256,8 @@ struct OrientationStereoOptions {
     v("write_orientation_maps", &write_orientation_maps,
       "write computed orientation fields to stereo/orientation_maps/");
     v("write_png", &write_png, "also write coloured depth and normal pictures (PNG)");
+    v("write_cost_volume", &write_cost_volume,
+      "write the coarse data term to stereo/cost_volumes/ (for evaluate_data_term)");
   }
   bool Check(std::string* error) const;
   // Window in px of a level (levels beyond 2 reuse the level-2 window).

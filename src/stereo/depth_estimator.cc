@@ -366,6 +366,12 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     if (coarse_volume_cache != nullptr) *coarse_volume_cache = coarse_volume;
   }
   const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
+  if (options.write_cost_volume && prior == nullptr) {
+    CostVolume& data_term = estimate.coarse_data_term;
+    data_term.cost = FloatMap(cw, ch, num_depths);
+    std::copy(coarse_volume.begin(), coarse_volume.end(), data_term.cost.Data().begin());
+    for (int k = 0; k < num_depths; ++k) data_term.label_depths.push_back(labels.Depth(k));
+  }
   float prior_scale = 0;
   if (use_prior) {
     ScopedStageTimer timer(timings, "geometric prior");

@@ -6,6 +6,7 @@
 
 #include <vector>
 
+#include "colmap_ext/mat_io.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/float_map.h"
 #include "src/core/timer.h"
@@ -40,6 +41,9 @@ struct DepthEstimate {
   double coarse_energy = 0;
   double fine_energy = 0;
   int num_valid = 0;
+  // With options.write_cost_volume and no prior: the coarse stage's aggregated data term
+  // before any prior or bound (coarse grid, one channel per label) and each label's depth.
+  CostVolume coarse_data_term;
 };
 
 // COLMAP's geometric pass: other views' depth maps as a prior on this view's depth. A depth D

@@ -570,6 +570,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : "geometric",
                            view->estimate.depth, view->K, options.write_png);
       WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
+      if (options.write_cost_volume) {
+        WriteCostVolume(workspace.CostVolumePath(name), workspace.CostVolumeDepthsPath(name),
+                        view->estimate.coarse_data_term);
+      }
     }
     estimated.push_back(name);
     if (!options.geom_consistency) {

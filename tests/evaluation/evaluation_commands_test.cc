@@ -200,6 +200,72 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
   EXPECT_LT(half_result.overall.accuracy_3d_mean_mm, 0.0502);
 }
 
+// Writes a cost volume for v0 on a 16 x 12 grid (4 x 4 image pixels each) with labels 5 mm
+// apart from 0.45 m (label 10 = 0.5 m, v0's true depth everywhere: it looks straight at the
+// plane z = 0.5), whose cheapest label is `cheapest` at every pixel.
+void WriteShiftedVolume(const Scene& scene, int cheapest, double first_depth = 0.45) {
+  CostVolume volume;
+  volume.cost = FloatMap(16, 12, 32);
+  for (int k = 0; k < 32; ++k) {
+    volume.label_depths.push_back(first_depth + 0.005 * k);
+    for (int r = 0; r < 12; ++r) {
+      for (int c = 0; c < 16; ++c) volume.cost.At(r, c, k) = (k - cheapest) * (k - cheapest);
+    }
+  }
+  const std::string volumes = JoinPaths(scene.workspace, "stereo", "cost_volumes");
+  WriteCostVolume(JoinPaths(volumes, "v0.png.coarse.bin"),
+                  JoinPaths(volumes, "v0.png.coarse.depths.txt"), volume);
+}
+
+TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
+  const Scene scene = MakeScene("data_term");
+  // The coarse pixels that are at least half hair, counted plainly.
+  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v0.png");
+  long half_hair = 0;
+  for (int r = 0; r < 12; ++r) {
+    for (int c = 0; c < 16; ++c) {
+      int hair = 0;
+      for (int y = 4 * r; y < 4 * r + 4; ++y) {
+        for (int x = 4 * c; x < 4 * c + 4; ++x) hair += truth.label[y * kWidth + x] == kLabelHair;
+      }
+      half_hair += hair >= 8;
+    }
+  }
+  ASSERT_GT(half_hair, 50);
+
+  WriteShiftedVolume(scene, 10);
+  const DataTermEvaluationResult at_truth =
+      EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions());
+  ASSERT_EQ(at_truth.views.size(), 1u);
+  EXPECT_EQ(at_truth.overall.num_pixels, half_hair);
+  EXPECT_EQ(at_truth.overall.num_outside_range, 0);
+  EXPECT_NEAR(at_truth.overall.label_step_mm, 5.0, 1e-6);
+  EXPECT_NEAR(at_truth.overall.median_abs_error_mm, 0.0, 1e-6);
+  EXPECT_DOUBLE_EQ(at_truth.overall.within_1_label, 1.0);
+  EXPECT_DOUBLE_EQ(at_truth.overall.within_5mm, 1.0);
+  EXPECT_NEAR(at_truth.overall.median_true_depth_rank, 0.0, 1.0 / 31);
+
+  // 6 labels (30 mm) behind: labels 11..21 cost less than the truth's 36.
+  WriteShiftedVolume(scene, 16);
+  const DataTermEvaluationResult shifted =
+      EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions());
+  EXPECT_EQ(shifted.overall.num_pixels, half_hair);
+  EXPECT_NEAR(shifted.overall.median_abs_error_mm, 30.0, 1e-6);
+  EXPECT_DOUBLE_EQ(shifted.overall.within_1_label, 0.0);
+  EXPECT_DOUBLE_EQ(shifted.overall.within_10mm, 0.0);
+  EXPECT_NEAR(shifted.overall.median_true_depth_rank, 11.0 / 31, 1e-9);
+  const auto json = nlohmann::json::parse(ReadTextFile(shifted.json_path));
+  EXPECT_EQ(json["overall"]["num_pixels"].get<long>(), half_hair);
+
+  // Labels from 0.6 m: every true depth lies outside them.
+  WriteShiftedVolume(scene, 10, 0.6);
+  const DataTermEvaluationResult outside =
+      EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions());
+  EXPECT_EQ(outside.overall.num_pixels, 0);
+  EXPECT_EQ(outside.overall.num_outside_range, half_hair);
+  std::filesystem::remove_all(scene.dir);
+}
+
 TEST(EvaluationCommands, ImportRefusesToWriteIntoItsInputs) {
   const Scene scene = MakeScene("refuse");
   EXPECT_THROW(ImportGroundTruth(scene.gt, scene.workspace, JoinPaths(scene.workspace, "x"),

@@ -100,6 +100,7 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   const FloatMap true_depth = WriteWorkspace(path)[0];
   OrientationStereoOptions options = PlaneOptions();
   options.write_png = true;
+  options.write_cost_volume = true;
   StageTimings timings;
   const OrientationStereoResult result =
       RunOrientationStereo(path, {"v0.png"}, options, &timings);
@@ -126,6 +127,35 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   std::printf("workspace plane: median |error| %.4f m over %zu pixels\n", median, errors.size());
   // About one pixel of disparity over the 0.3 m baselines at 1 m is 30 mm.
   EXPECT_LT(median, 0.02);
+  // The coarse data term as first estimated: the coarse grid (level 1: 48 x 36), a channel per
+  // label, the labels' depths spanning the range; alone (no MRF), its cheapest labels lie near
+  // the plane (median 8 mm when written; one level-0 pixel of disparity is about 30 mm).
+  EXPECT_FALSE(ExistsFile(workspace.CostVolumePath("v1.png")));
+  const CostVolume volume =
+      ReadCostVolume(workspace.CostVolumePath("v0.png"), workspace.CostVolumeDepthsPath("v0.png"));
+  ASSERT_EQ(volume.cost.Width(), 48);
+  ASSERT_EQ(volume.cost.Height(), 36);
+  ASSERT_EQ(volume.cost.Channels(), options.num_depths);
+  EXPECT_NEAR(std::min(volume.label_depths.front(), volume.label_depths.back()), 0.7, 1e-6);
+  EXPECT_NEAR(std::max(volume.label_depths.front(), volume.label_depths.back()), 1.5, 1e-6);
+  std::vector<double> argmin_errors;
+  for (int r = 0; r < 36; ++r) {
+    for (int c = 0; c < 48; ++c) {
+      const float truth = true_depth.At(2 * r + 1, 2 * c + 1);
+      if (!(truth > 0)) continue;
+      int best = 0;
+      for (int k = 1; k < volume.cost.Channels(); ++k) {
+        if (volume.cost.At(r, c, k) < volume.cost.At(r, c, best)) best = k;
+      }
+      argmin_errors.push_back(std::abs(volume.label_depths[best] - truth));
+    }
+  }
+  ASSERT_GT(argmin_errors.size(), 48u * 36u / 2);
+  std::nth_element(argmin_errors.begin(), argmin_errors.begin() + argmin_errors.size() / 2,
+                   argmin_errors.end());
+  const double argmin_median = argmin_errors[argmin_errors.size() / 2];
+  std::printf("workspace plane: data term alone, median |error| %.4f m\n", argmin_median);
+  EXPECT_LT(argmin_median, 0.03);
   // The orientation fields were cached for reuse.
   EXPECT_TRUE(ExistsFile(workspace.OrientationMapPath("v1.png", 0)));
   // Its sources have no depth maps yet: the .geometric map is the estimate, unfiltered.

@@ -1,0 +1,223 @@
+// EvaluateDataTerm: where the cheapest label of each coarse pixel lies against the true depth.
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "colmap_ext/workspace.h"
+#include "hairmvs/evaluation.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/progress.h"
+#include "src/evaluation/evaluation_util.h"
+#include "src/evaluation/ground_truth.h"
+
+namespace hairmvs {
+namespace {
+
+// Per evaluated coarse pixel (one view's, or all views' pooled).
+struct DataTermSamples {
+  long num_outside_range = 0;
+  std::vector<double> abs_errors_m;    // cheapest label's depth vs the true depth
+  std::vector<double> label_errors;    // |cheapest label - true label position|
+  std::vector<double> label_steps_m;   // depth step between the labels around the truth
+  std::vector<double> true_depth_ranks;
+};
+
+DataTermMetrics Summarize(const std::string& name, const DataTermSamples& samples) {
+  DataTermMetrics m;
+  m.name = name;
+  m.num_pixels = static_cast<long>(samples.abs_errors_m.size());
+  m.num_outside_range = samples.num_outside_range;
+  m.label_step_mm = 1e3 * Percentile(samples.label_steps_m, 0.5);
+  m.median_abs_error_mm = 1e3 * Percentile(samples.abs_errors_m, 0.5);
+  m.median_true_depth_rank = Percentile(samples.true_depth_ranks, 0.5);
+  long n1 = 0, n5 = 0, n10 = 0;
+  for (size_t i = 0; i < samples.abs_errors_m.size(); ++i) {
+    n1 += samples.label_errors[i] <= 1.0;
+    n5 += samples.abs_errors_m[i] <= 5e-3;
+    n10 += samples.abs_errors_m[i] <= 10e-3;
+  }
+  const double n = std::max<long>(1, m.num_pixels);
+  m.within_1_label = n1 / n;
+  m.within_5mm = n5 / n;
+  m.within_10mm = n10 / n;
+  return m;
+}
+
+nlohmann::json ToJson(const DataTermMetrics& m) {
+  return {{"name", m.name},
+          {"num_pixels", m.num_pixels},
+          {"num_outside_range", m.num_outside_range},
+          {"label_step_mm", m.label_step_mm},
+          {"median_abs_error_mm", m.median_abs_error_mm},
+          {"within_1_label", m.within_1_label},
+          {"within_5mm", m.within_5mm},
+          {"within_10mm", m.within_10mm},
+          {"median_true_depth_rank", m.median_true_depth_rank}};
+}
+
+std::string TableRow(const DataTermMetrics& m) {
+  char line[256];
+  std::snprintf(line, sizeof(line), "%-14s %8ld %7ld %7.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %6.3f\n",
+                m.name.c_str(), m.num_pixels, m.num_outside_range, m.label_step_mm,
+                m.median_abs_error_mm, 100 * m.within_1_label, 100 * m.within_5mm,
+                100 * m.within_10mm, m.median_true_depth_rank);
+  return line;
+}
+
+// The fractional label position of `depth` among monotone `depths` (increasing or decreasing
+// with the label); false when outside them.
+bool LabelPosition(const std::vector<double>& depths, double depth, double* position) {
+  for (size_t k = 0; k + 1 < depths.size(); ++k) {
+    const double lo = std::min(depths[k], depths[k + 1]);
+    const double hi = std::max(depths[k], depths[k + 1]);
+    if (depth >= lo && depth <= hi) {
+      *position = k + (depth - depths[k]) / (depths[k + 1] - depths[k]);
+      return true;
+    }
+  }
+  return false;
+}
+
+// The samples of one view: its volume against the true depths.
+void EvaluateView(const CostVolume& volume, const GroundTruthView& gt, double min_hair_fraction,
+                  DataTermSamples* samples) {
+  const FloatMap& cost = volume.cost;
+  const std::vector<double>& depths = volume.label_depths;
+  const int cw = cost.Width(), ch = cost.Height(), num_labels = cost.Channels();
+  const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
+  std::vector<double> hair_depths;
+  std::vector<float> costs(num_labels);
+  for (int r = 0; r < ch; ++r) {
+    // The image pixels whose centres fall into coarse pixel (r, c) (SfM convention: the grids
+    // share their edges).
+    const int row_begin = static_cast<int>(std::ceil(static_cast<double>(r) * gt_height / ch - 0.5));
+    const int row_end = static_cast<int>(std::ceil((r + 1.0) * gt_height / ch - 0.5));
+    for (int c = 0; c < cw; ++c) {
+      const int col_begin = static_cast<int>(std::ceil(static_cast<double>(c) * gt_width / cw - 0.5));
+      const int col_end = static_cast<int>(std::ceil((c + 1.0) * gt_width / cw - 0.5));
+      hair_depths.clear();
+      int covered = 0;
+      for (int gr = std::max(0, row_begin); gr < std::min(gt_height, row_end); ++gr) {
+        for (int gc = std::max(0, col_begin); gc < std::min(gt_width, col_end); ++gc) {
+          ++covered;
+          const float d = gt.depth.At(gr, gc);
+          if (gt.label[static_cast<size_t>(gr) * gt_width + gc] == kLabelHair && d > 0) {
+            hair_depths.push_back(d);
+          }
+        }
+      }
+      if (covered == 0 || hair_depths.empty() ||
+          hair_depths.size() < min_hair_fraction * covered) {
+        continue;
+      }
+      for (int k = 0; k < num_labels; ++k) costs[k] = cost.At(r, c, k);
+      const auto [lo, hi] = std::minmax_element(costs.begin(), costs.end());
+      if (!(*hi > *lo)) continue;  // no data term here (masked)
+      const double true_depth = Percentile(hair_depths, 0.5);
+      double position;
+      if (!LabelPosition(depths, true_depth, &position)) {
+        ++samples->num_outside_range;
+        continue;
+      }
+      const int below = std::min(static_cast<int>(position), num_labels - 2);
+      const double frac = position - below;
+      const double true_cost = (1 - frac) * costs[below] + frac * costs[below + 1];
+      const int cheapest = static_cast<int>(lo - costs.begin());
+      samples->abs_errors_m.push_back(std::abs(depths[cheapest] - true_depth));
+      samples->label_errors.push_back(std::abs(cheapest - position));
+      samples->label_steps_m.push_back(std::abs(depths[below + 1] - depths[below]));
+      const long cheaper = std::count_if(costs.begin(), costs.end(),
+                                         [true_cost](float x) { return x < true_cost; });
+      samples->true_depth_ranks.push_back(static_cast<double>(cheaper) / (num_labels - 1));
+    }
+  }
+}
+
+void Append(const DataTermSamples& from, DataTermSamples* to) {
+  to->num_outside_range += from.num_outside_range;
+  auto append = [](const std::vector<double>& a, std::vector<double>* b) {
+    b->insert(b->end(), a.begin(), a.end());
+  };
+  append(from.abs_errors_m, &to->abs_errors_m);
+  append(from.label_errors, &to->label_errors);
+  append(from.label_steps_m, &to->label_steps_m);
+  append(from.true_depth_ranks, &to->true_depth_ranks);
+}
+
+}  // namespace
+
+bool DataTermEvaluationOptions::Check(std::string* error) const {
+  if (!(min_hair_fraction > 0 && min_hair_fraction <= 1)) {
+    *error = "EvaluateDataTerm.min_hair_fraction must be in (0, 1]";
+    return false;
+  }
+  return CheckImageNames(image_names, error);
+}
+
+std::string DataTermEvaluationResult::Table() const {
+  std::ostringstream out;
+  out << "view             pixels outside step_mm  med_mm  <=1lab  <=5mm <=10mm  rank\n";
+  for (const DataTermMetrics& m : views) out << TableRow(m);
+  out << TableRow(overall);
+  if (!json_path.empty()) out << "Summary: " << json_path << "\n";
+  return out.str();
+}
+
+DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
+                                          const std::string& ground_truth_path,
+                                          const DataTermEvaluationOptions& options) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  const Workspace ws = Workspace::Read(workspace_path);
+  std::vector<std::string> names = options.image_names;
+  if (names.empty()) {
+    for (const std::string& name : ws.ImageNames()) {
+      if (ExistsFile(ws.CostVolumePath(name))) names.push_back(name);
+    }
+    THROW_IF(names.empty(), "No cost volumes in " << JoinPaths(ws.StereoPath(), "cost_volumes")
+                                                  << " (run orientation_stereo with "
+                                                  << "--OrientationStereo.write_cost_volume 1)");
+  }
+  DataTermEvaluationResult result;
+  DataTermSamples pooled;
+  Progress progress("evaluate_data_term", static_cast<int>(names.size()));
+  for (size_t v = 0; v < names.size(); ++v) {
+    const std::string& name = names[v];
+    progress.Start(static_cast<int>(v), name);
+    const CostVolume volume =
+        ReadCostVolume(ws.CostVolumePath(name), ws.CostVolumeDepthsPath(name));
+    THROW_IF(volume.cost.Channels() < 2,
+             ws.CostVolumePath(name) << ": a cost volume needs at least 2 labels");
+    DataTermSamples samples;
+    EvaluateView(volume, ReadGroundTruthView(ground_truth_path, name),
+                 options.min_hair_fraction, &samples);
+    result.views.push_back(Summarize(name, samples));
+    Append(samples, &pooled);
+  }
+  progress.Finish();
+  result.overall = Summarize("overall", pooled);
+
+  nlohmann::json json;
+  json["workspace_path"] = workspace_path;
+  json["ground_truth_path"] = ground_truth_path;
+  json["min_hair_fraction"] = options.min_hair_fraction;
+  json["overall"] = ToJson(result.overall);
+  json["views"] = nlohmann::json::array();
+  for (const DataTermMetrics& m : result.views) json["views"].push_back(ToJson(m));
+  const std::string output_path = options.output_path.empty()
+                                      ? JoinPaths(ws.StereoPath(), "evaluation")
+                                      : options.output_path;
+  result.json_path = JoinPaths(output_path, "data_term_evaluation.json");
+  const std::string text = json.dump(1);
+  WriteFileAtomically(result.json_path, [&text](std::ostream& out) { out << text << "\n"; },
+                      false);
+  return result;
+}
+
+}  // namespace hairmvs
