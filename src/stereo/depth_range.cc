@@ -20,10 +20,11 @@ struct Projection {
 };
 
 // Whether the point X (reference camera frame) is inside the hull: seen inside the image by at
-// least `min_observing` views and inside the mask of every view that sees it.
-bool InsideHull(const std::vector<Projection>& projections, int min_observing,
+// least `min_observing` views, and outside the mask of fewer than `min_carving` of them (all of
+// them, when fewer see it).
+bool InsideHull(const std::vector<Projection>& projections, int min_observing, int min_carving,
                 const Eigen::Vector3d& X) {
-  int observing = 0;
+  int observing = 0, carving = 0;
   for (const Projection& p : projections) {
     const Eigen::Vector3d u = p.A * X + p.c;
     if (!(u.z() > 0)) continue;  // behind the view: it cannot see the point
@@ -32,9 +33,9 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing,
     ++observing;
     const int c = std::min(static_cast<int>(x), p.camera->width - 1);
     const int r = std::min(static_cast<int>(y), p.camera->height - 1);
-    if (!(p.mask->At(r, c) > 0.5f)) return false;
+    if (!(p.mask->At(r, c) > 0.5f) && ++carving >= min_carving) return false;
   }
-  return observing >= std::max(1, min_observing);
+  return observing >= std::max(1, min_observing) && carving < std::max(1, std::min(min_carving, observing));
 }
 
 }  // namespace
@@ -75,7 +76,8 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
       const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
       // z-depth: the ray has z = 1.
       auto inside = [&](double k) {
-        return InsideHull(projections, min_observing, ray / inverse_depth(k));
+        return InsideHull(projections, min_observing, options.min_carving_views,
+                          ray / inverse_depth(k));
       };
       int entry = -1;
       for (int k = 0; k < n && entry < 0; ++k) {

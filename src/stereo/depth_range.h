@@ -34,6 +34,10 @@ struct VisualHullRangeOptions {
   // only is carved by one epipolar line, which crosses that view's mask over long stretches
   // when the two views are close (handheld h10: 0.21-5.03 m with 1, 0.42-0.67 m with 3).
   int min_observing_views = 3;
+  // A depth sample is carved only when at least this many of the views that see it have it
+  // outside their mask (capped at their number): 1 is the strict hull; 2 lets no single view
+  // with a wrong pose or a wrong mask carve away what the others keep.
+  int min_carving_views = 1;
   // Fewer sampled rays entering the hull than this: no range (returns false).
   int min_rays_in_hull = 4;
 };

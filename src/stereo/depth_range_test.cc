@@ -139,6 +139,40 @@ TEST(DepthRangeTest, HullIntervalsStartInFrontOfTheSurface) {
   }
 }
 
+TEST(DepthRangeTest, OneViewWithAWrongPoseCarvesOnlyTheStrictHull) {
+  Scene scene = MakeScene(7);
+  for (auto& view : scene.others) view.second = Dilated(view.second);
+  // View 2's mask is 8 px off its pose (a wrong calibration: 2.3 degrees of rotation).
+  const FloatMap right = scene.others[2].second;
+  FloatMap shifted(right.Width(), right.Height(), 1, 0.0f);
+  for (int row = 0; row < right.Height(); ++row) {
+    for (int col = 0; col + 8 < right.Width(); ++col) shifted.At(row, col) = right.At(row, col + 8);
+  }
+  scene.others[2].second = shifted;
+  const FloatMap mask = SphereMask(scene.ref);
+  const Eigen::Matrix3d K_inv = scene.ref.K.inverse();
+  // Rays whose hull entry lies more than 2 mm behind where they enter the sphere.
+  auto carved_rays = [&](int min_carving_views) {
+    VisualHullRangeOptions options = EveryPixel(false);
+    options.min_carving_views = min_carving_views;
+    const FloatMap intervals = VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, options);
+    int carved = 0;
+    for (int row = 0; row < scene.ref.height; ++row) {
+      for (int col = 0; col < scene.ref.width; ++col) {
+        const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1);
+        const double a = ray.squaredNorm(), b = -ray.dot(kCentre);
+        const double disc = b * b - a * (kCentre.squaredNorm() - kRadius * kRadius);
+        if (!(mask.At(row, col) > 0.5f) || disc < 0) continue;
+        const float near_m = intervals.At(row, col, 0);
+        carved += !(near_m > 0) || near_m > (-b - std::sqrt(disc)) / a + 2e-3;
+      }
+    }
+    return carved;
+  };
+  EXPECT_GT(carved_rays(1), 300);
+  EXPECT_EQ(carved_rays(2), 0);
+}
+
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {
   Scene scene = MakeScene(7);
   const FloatMap ref_mask = SphereMask(scene.ref);

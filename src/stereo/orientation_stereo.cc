@@ -136,6 +136,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "geom_consistency_only needs geom_consistency; ";
   }
   if (visual_hull_mask_dilation_px < 0) e << "visual_hull_mask_dilation_px must be >= 0; ";
+  if (visual_hull_min_carving_views < 1) e << "visual_hull_min_carving_views must be >= 1; ";
   if (num_levels < 1) e << "num_levels must be >= 1; ";
   if (window_px_level0 < 1 || window_px_level1 < 1 || window_px_level2 < 1) {
     e << "window_px_level* must be >= 1; ";
@@ -484,23 +485,33 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         if (depth_min <= 0) depth_min = range.min_m;
         if (depth_max <= 0) depth_max = range.max_m;
         range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
-        // The masks' visual hull, searched over COLMAP's all-points range widened to
-        // [0.5 min, 2 max]: the sparse points of a textured room say little about the head.
+        // The masks' visual hull, searched over COLMAP's all-points range and the in-mask one
+        // together, widened to [0.5 min, 2 max]: the sparse points of a textured room say
+        // little about the head, and those inside the mask may be wrong too (hair is hard to
+        // match: synth_handheld h02's lie at 0.69 m and more, its hair at 0.35-0.62 m, and the
+        // all-points range starts at 1.14 m).
         const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
+        double search_min = wide.min_m, search_max = wide.max_m;
+        if (range.inside_mask) {  // else `range` is `wide`
+          search_min = std::min(search_min, range.min_m);
+          search_max = std::max(search_max, range.max_m);
+        }
         double hull_min = 0, hull_max = 0;
+        VisualHullRangeOptions hull_options;
+        hull_options.min_carving_views = options.visual_hull_min_carving_views;
         if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
-            wide.min_m > 0 && wide.max_m > wide.min_m &&
-            VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * wide.min_m,
-                                 2 * wide.max_m, &hull_min, &hull_max)) {
-          // Intersected with the sparse points' range inside the mask where there is one: the
-          // hull of a single T group (4 nearly parallel views) is long along the line of sight
-          // (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with the points:
-          // 3.4 x finer labels).
+            search_min > 0 && search_max > search_min &&
+            VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * search_min,
+                                 2 * search_max, &hull_min, &hull_max, hull_options)) {
+          // Narrowed to the sparse points' range inside the mask when that lies within the
+          // hull's: the hull of a single T group (4 nearly parallel views) is long along the
+          // line of sight (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with
+          // the points: 3.4 x finer labels). A range that reaches out of the hull disagrees
+          // with the masks: the points are wrong (synth_handheld h02), the hull is kept.
           range_source = "visual hull";
-          if (range.inside_mask &&
-              std::max(hull_min, range.min_m) < std::min(hull_max, range.max_m)) {
-            hull_min = std::max(hull_min, range.min_m);
-            hull_max = std::min(hull_max, range.max_m);
+          if (range.inside_mask && range.min_m >= hull_min && range.max_m <= hull_max) {
+            hull_min = range.min_m;
+            hull_max = range.max_m;
             range_source = "visual hull and sparse points in mask";
           }
           if (options.depth_min <= 0) depth_min = hull_min;
@@ -517,6 +528,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         VisualHullRangeOptions every_pixel_entries;
         every_pixel_entries.pixel_step = 1;
         every_pixel_entries.find_far_ends = false;  // only the entry bounds the depth
+        every_pixel_entries.min_carving_views = options.visual_hull_min_carving_views;
         const FloatMap intervals =
             VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
                                 2 * depth_max, every_pixel_entries);
