@@ -10,7 +10,9 @@ namespace hairmvs {
 namespace {
 
 TEST(OrientationFilterBank, ZeroMeanSymmetricAndRotated) {
-  const OrientationFieldOptions options;
+  OrientationFieldOptions options;  // the paper's filter: 0.5 / 1 px across, 4 px along
+  options.sigma_across_inner_px = 0.5;
+  options.sigma_across_outer_px = 1.0;
   const OrientationFilterBank bank(options);
   ASSERT_EQ(bank.NumOrientations(), 180);
   EXPECT_EQ(bank.Radius(), 12);  // 3 sigma_along

@@ -170,15 +170,15 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   const std::string stereo_path = JoinPaths(root, "stereo"), fields_path = JoinPaths(root, "f");
   WriteWorkspace(stereo_path);
   WriteWorkspace(fields_path);
-  OrientationFieldOptions wide;
-  wide.sigma_across_inner_px = 1.0;
-  wide.sigma_across_outer_px = 2.0;
+  OrientationFieldOptions paper;  // the paper's filter, narrower than the default
+  paper.sigma_across_inner_px = 0.5;
+  paper.sigma_across_outer_px = 1.0;
   OrientationStereoOptions options = PlaneOptions();
   StageTimings timings;
-  RunOrientationStereo(stereo_path, {"v0.png"}, options, &timings, "", nullptr, &wide);
+  RunOrientationStereo(stereo_path, {"v0.png"}, options, &timings, "", nullptr, &paper);
   // The fields cached by the stereo are those `orientation_fields` makes with the same filter,
   // and not the default filter's.
-  RunOrientationFields(fields_path, wide, OrientationFieldsRunOptions(), &timings);
+  RunOrientationFields(fields_path, paper, OrientationFieldsRunOptions(), &timings);
   const Workspace stereo_ws = Workspace::Read(stereo_path);
   const Workspace fields_ws = Workspace::Read(fields_path);
   const FloatMap cached = ReadMat(stereo_ws.OrientationMapPath("v1.png", 0));
