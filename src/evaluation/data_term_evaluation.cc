@@ -84,6 +84,12 @@ bool LabelPosition(const std::vector<double>& depths, double depth, double* posi
   return false;
 }
 
+// The first pixel of a grid of `fine_size` whose centre lies in pixel `coarse` of a grid of
+// `coarse_size` over the same image, or beyond (SfM convention: the grids share their edges).
+int FirstFinePixel(int coarse, int fine_size, int coarse_size) {
+  return static_cast<int>(std::ceil(static_cast<double>(coarse) * fine_size / coarse_size - 0.5));
+}
+
 // The samples of one view: its volume against the true depths.
 void EvaluateView(const CostVolume& volume, const GroundTruthView& gt, double min_hair_fraction,
                   DataTermSamples* samples) {
@@ -94,13 +100,12 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt, double mi
   std::vector<double> hair_depths;
   std::vector<float> costs(num_labels);
   for (int r = 0; r < ch; ++r) {
-    // The image pixels whose centres fall into coarse pixel (r, c) (SfM convention: the grids
-    // share their edges).
-    const int row_begin = static_cast<int>(std::ceil(static_cast<double>(r) * gt_height / ch - 0.5));
-    const int row_end = static_cast<int>(std::ceil((r + 1.0) * gt_height / ch - 0.5));
+    // The image pixels whose centres fall into coarse pixel (r, c).
+    const int row_begin = FirstFinePixel(r, gt_height, ch);
+    const int row_end = FirstFinePixel(r + 1, gt_height, ch);
     for (int c = 0; c < cw; ++c) {
-      const int col_begin = static_cast<int>(std::ceil(static_cast<double>(c) * gt_width / cw - 0.5));
-      const int col_end = static_cast<int>(std::ceil((c + 1.0) * gt_width / cw - 0.5));
+      const int col_begin = FirstFinePixel(c, gt_width, cw);
+      const int col_end = FirstFinePixel(c + 1, gt_width, cw);
       hair_depths.clear();
       int covered = 0;
       for (int gr = std::max(0, row_begin); gr < std::min(gt_height, row_end); ++gr) {

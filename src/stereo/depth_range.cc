@@ -35,7 +35,8 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing, i
     const int r = std::min(static_cast<int>(y), p.camera->height - 1);
     if (!(p.mask->At(r, c) > 0.5f) && ++carving >= min_carving) return false;
   }
-  return observing >= std::max(1, min_observing) && carving < std::max(1, std::min(min_carving, observing));
+  return observing >= std::max(1, min_observing) &&
+         carving < std::max(1, std::min(min_carving, observing));
 }
 
 }  // namespace

@@ -155,7 +155,8 @@ TEST(DepthRangeTest, OneViewWithAWrongPoseCarvesOnlyTheStrictHull) {
   auto carved_rays = [&](int min_carving_views) {
     VisualHullRangeOptions options = EveryPixel(false);
     options.min_carving_views = min_carving_views;
-    const FloatMap intervals = VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, options);
+    const FloatMap intervals =
+        VisualHullIntervals(scene.ref, mask, scene.others, 0.3, 5.0, options);
     int carved = 0;
     for (int row = 0; row < scene.ref.height; ++row) {
       for (int col = 0; col < scene.ref.width; ++col) {

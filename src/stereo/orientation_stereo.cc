@@ -488,8 +488,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         // The masks' visual hull, searched over COLMAP's all-points range and the in-mask one
         // together, widened to [0.5 min, 2 max]: the sparse points of a textured room say
         // little about the head, and those inside the mask may be wrong too (hair is hard to
-        // match: synth_handheld h02's lie at 0.69 m and more, its hair at 0.35-0.62 m, and the
-        // all-points range starts at 1.14 m).
+        // match: synth_handheld h02's points in its mask lie 0.69 m away and more, its hair at
+        // 0.35-0.62 m, and its all-points range starts at 1.14 m).
         const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
         double search_min = wide.min_m, search_max = wide.max_m;
         if (range.inside_mask) {  // else `range` is `wide`
