@@ -141,4 +141,26 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
   return *max_m > *min_m;
 }
 
+bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
+                             const std::vector<std::pair<StereoCamera, FloatMap>>& others,
+                             const DepthRange& all_points, const DepthRange& in_mask,
+                             double* min_m, double* max_m, bool* narrowed,
+                             const VisualHullRangeOptions& options) {
+  double search_min = all_points.min_m, search_max = all_points.max_m;
+  if (in_mask.inside_mask) {
+    search_min = std::min(search_min, in_mask.min_m);
+    search_max = std::max(search_max, in_mask.max_m);
+  }
+  double hull_min = 0, hull_max = 0;
+  if (!(search_min > 0 && search_max > search_min) ||
+      !VisualHullDepthRange(ref, ref_mask, others, 0.5 * search_min, 2 * search_max, &hull_min,
+                            &hull_max, options)) {
+    return false;
+  }
+  *narrowed = in_mask.inside_mask && in_mask.min_m >= hull_min && in_mask.max_m <= hull_max;
+  *min_m = *narrowed ? in_mask.min_m : hull_min;
+  *max_m = *narrowed ? in_mask.max_m : hull_max;
+  return true;
+}
+
 }  // namespace hairmvs

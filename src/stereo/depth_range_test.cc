@@ -174,6 +174,49 @@ TEST(DepthRangeTest, OneViewWithAWrongPoseCarvesOnlyTheStrictHull) {
   EXPECT_EQ(carved_rays(2), 0);
 }
 
+DepthRange Points(double min_m, double max_m, bool inside_mask) {
+  DepthRange range;
+  range.min_m = min_m;
+  range.max_m = max_m;
+  range.inside_mask = inside_mask;
+  return range;
+}
+
+TEST(DepthRangeTest, HullAndPointsRangeKeepsTheHullWhenThePointsDisagree) {
+  const Scene scene = MakeScene(7);
+  const FloatMap mask = SphereMask(scene.ref);
+  // The sphere lies at depths 0.9-1.1. All the view's points are far (a room): searched from
+  // half their near end only, the hull would start behind the sphere's front.
+  const DepthRange room = Points(2.0, 5.0, false);
+  double min_m = 0, max_m = 0;
+  ASSERT_TRUE(
+      VisualHullDepthRange(scene.ref, mask, scene.others, 1.0, 10.0, &min_m, &max_m));
+  EXPECT_GE(min_m, 1.0);
+  // The points in the mask are wrong too (behind the sphere and beyond), but nearer than the
+  // room's: the hull is searched from half their near end and kept as it is.
+  bool narrowed = true;
+  ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
+                                      Points(0.7, 3.0, true), &min_m, &max_m, &narrowed));
+  EXPECT_FALSE(narrowed);
+  EXPECT_LT(min_m, 0.9);
+  EXPECT_GT(max_m, 1.1);
+  EXPECT_LT(max_m - min_m, 0.5);
+  // Points in the mask whose range lies within the hull's narrow it (a long T-group hull).
+  ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
+                                      Points(0.92, 1.08, true), &min_m, &max_m, &narrowed));
+  EXPECT_TRUE(narrowed);
+  EXPECT_EQ(min_m, 0.92);
+  EXPECT_EQ(max_m, 1.08);
+  // Not from the mask (COLMAP's fallback to all points): never narrows.
+  ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(0.6, 3.0, false),
+                                      Points(0.92, 1.08, false), &min_m, &max_m, &narrowed));
+  EXPECT_FALSE(narrowed);
+  EXPECT_LT(min_m, 0.9);
+  // No points at all: no range.
+  EXPECT_FALSE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(-1, -1, false),
+                                       Points(-1, -1, false), &min_m, &max_m, &narrowed));
+}
+
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {
   Scene scene = MakeScene(7);
   const FloatMap ref_mask = SphereMask(scene.ref);

@@ -485,35 +485,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         if (depth_min <= 0) depth_min = range.min_m;
         if (depth_max <= 0) depth_max = range.max_m;
         range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
-        // The masks' visual hull, searched over COLMAP's all-points range and the in-mask one
-        // together, widened to [0.5 min, 2 max]: the sparse points of a textured room say
-        // little about the head, and those inside the mask may be wrong too (hair is hard to
-        // match: synth_handheld h02's points in its mask lie 0.69 m away and more, its hair at
-        // 0.35-0.62 m, and its all-points range starts at 1.14 m).
-        const DepthRange wide = ComputeDepthRange(workspace.Model(), image_id);
-        double search_min = wide.min_m, search_max = wide.max_m;
-        if (range.inside_mask) {  // else `range` is `wide`
-          search_min = std::min(search_min, range.min_m);
-          search_max = std::max(search_max, range.max_m);
-        }
-        double hull_min = 0, hull_max = 0;
+        // The masks' visual hull: the sparse points of a textured room say little about the
+        // head, and those in the mask may be wrong too.
         VisualHullRangeOptions hull_options;
         hull_options.min_carving_views = options.visual_hull_min_carving_views;
+        double hull_min = 0, hull_max = 0;
+        bool narrowed = false;
         if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
-            search_min > 0 && search_max > search_min &&
-            VisualHullDepthRange(ref.camera, mask, loader.MaskedViews(name), 0.5 * search_min,
-                                 2 * search_max, &hull_min, &hull_max, hull_options)) {
-          // Narrowed to the sparse points' range inside the mask when that lies within the
-          // hull's: the hull of a single T group (4 nearly parallel views) is long along the
-          // line of sight (synthesised curly group: 0.17-1.40 m by the hull, 0.38-0.87 m with
-          // the points: 3.4 x finer labels). A range that reaches out of the hull disagrees
-          // with the masks: the points are wrong (synth_handheld h02), the hull is kept.
-          range_source = "visual hull";
-          if (range.inside_mask && range.min_m >= hull_min && range.max_m <= hull_max) {
-            hull_min = range.min_m;
-            hull_max = range.max_m;
-            range_source = "visual hull and sparse points in mask";
-          }
+            HullAndPointsDepthRange(ref.camera, mask, loader.MaskedViews(name),
+                                    ComputeDepthRange(workspace.Model(), image_id), range,
+                                    &hull_min, &hull_max, &narrowed, hull_options)) {
+          range_source = narrowed ? "visual hull and sparse points in mask" : "visual hull";
           if (options.depth_min <= 0) depth_min = hull_min;
           if (options.depth_max <= 0) depth_max = hull_max;
         }
