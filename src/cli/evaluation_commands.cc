@@ -47,50 +47,50 @@ int RunImportGroundTruth(int argc, char** argv) {
   return 0;
 }
 
-int RunEvaluateDepth(int argc, char** argv) {
+// evaluate_depth and evaluate_data_term: a workspace and the data set's truth, plain options,
+// `evaluate(workspace_path, ground_truth_path, options)` whose result prints a per-view table.
+template <typename OptionsT, typename EvaluateFn>
+int RunWorkspaceEvaluation(int argc, char** argv, const char* name, const char* description,
+                           const char* workspace_help, EvaluateFn evaluate) {
   std::string ground_truth_path, workspace_path;
-  DepthEvaluationOptions options;
-  OptionParser parser(
-      "evaluate_depth",
-      "Compares a workspace's depth maps with the true ones on the hair pixels (label 2): "
-      "absolute error (mean, median, fraction within 1/2/5 mm), completeness, and 3D accuracy "
-      "(pixels back-projected with the workspace's cameras, distance to the nearest true "
-      "strand). Writes <output>/<name>.error.png and <output>/depth_evaluation.json.");
-  parser.Add("workspace_path", &workspace_path, "dense workspace with depth maps", true);
+  OptionsT options;
+  OptionParser parser(name, description);
+  parser.Add("workspace_path", &workspace_path, workspace_help, true);
   parser.Add("ground_truth_path", &ground_truth_path, "the data set's gt/ folder", true);
   AddPlain(&parser, &options);
   if (!parser.Parse(argc, argv)) return 0;
   CheckOrThrow(options);
   Timer timer;
-  const DepthEvaluationResult result =
-      EvaluateDepthMaps(workspace_path, ground_truth_path, options);
+  const auto result = evaluate(workspace_path, ground_truth_path, options);
   std::printf("%s", result.Table().c_str());
   std::printf("Evaluated %zu views in %.1f s\n", result.views.size(), timer.ElapsedSeconds());
   return 0;
 }
 
+int RunEvaluateDepth(int argc, char** argv) {
+  return RunWorkspaceEvaluation<DepthEvaluationOptions>(
+      argc, argv, "evaluate_depth",
+      "Compares a workspace's depth maps with the true ones on the hair pixels (label 2): "
+      "absolute error (mean, median, fraction within 1/2/5 mm), completeness, and 3D accuracy "
+      "(pixels back-projected with the workspace's cameras, distance to the nearest true "
+      "strand). Writes <output>/<name>.error.png and <output>/depth_evaluation.json.",
+      "dense workspace with depth maps",
+      [](const std::string& workspace, const std::string& truth,
+         const DepthEvaluationOptions& options) {
+        return EvaluateDepthMaps(workspace, truth, options);
+      });
+}
+
 int RunEvaluateDataTerm(int argc, char** argv) {
-  std::string ground_truth_path, workspace_path;
-  DataTermEvaluationOptions options;
-  OptionParser parser(
-      "evaluate_data_term",
+  return RunWorkspaceEvaluation<DataTermEvaluationOptions>(
+      argc, argv, "evaluate_data_term",
       "The data term alone, before the MRF: for each coarse pixel of the cost volumes that "
       "orientation_stereo --OrientationStereo.write_cost_volume 1 wrote, the cheapest label "
       "against the true depth (median of the hair pixels it covers): its error (median, "
       "within 1 label, 5 and 10 mm) and the fraction of labels cheaper than the true depth "
       "(median rank, 0 = the truth is the minimum). Writes "
-      "<output>/data_term_evaluation.json.");
-  parser.Add("workspace_path", &workspace_path, "dense workspace with stereo/cost_volumes/", true);
-  parser.Add("ground_truth_path", &ground_truth_path, "the data set's gt/ folder", true);
-  AddPlain(&parser, &options);
-  if (!parser.Parse(argc, argv)) return 0;
-  CheckOrThrow(options);
-  Timer timer;
-  const DataTermEvaluationResult result =
-      EvaluateDataTerm(workspace_path, ground_truth_path, options);
-  std::printf("%s", result.Table().c_str());
-  std::printf("Evaluated %zu views in %.1f s\n", result.views.size(), timer.ElapsedSeconds());
-  return 0;
+      "<output>/data_term_evaluation.json.",
+      "dense workspace with stereo/cost_volumes/", EvaluateDataTerm);
 }
 
 int RunEvaluateMesh(int argc, char** argv) {

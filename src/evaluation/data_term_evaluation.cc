@@ -180,15 +180,10 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
   std::string error;
   THROW_IF(!options.Check(&error), error);
   const Workspace ws = Workspace::Read(workspace_path);
-  std::vector<std::string> names = options.image_names;
-  if (names.empty()) {
-    for (const std::string& name : ws.ImageNames()) {
-      if (ExistsFile(ws.CostVolumePath(name))) names.push_back(name);
-    }
-    THROW_IF(names.empty(), "No cost volumes in " << JoinPaths(ws.StereoPath(), "cost_volumes")
-                                                  << " (run orientation_stereo with "
-                                                  << "--OrientationStereo.write_cost_volume 1)");
-  }
+  const std::vector<std::string> names = ViewsToEvaluate(
+      ws, options.image_names, [&](const std::string& name) { return ws.CostVolumePath(name); },
+      "No cost volumes in " + JoinPaths(ws.StereoPath(), "cost_volumes") +
+          " (run orientation_stereo with --OrientationStereo.write_cost_volume 1)");
   DataTermEvaluationResult result;
   DataTermSamples pooled;
   Progress progress("evaluate_data_term", static_cast<int>(names.size()));
@@ -215,13 +210,9 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
   json["overall"] = ToJson(result.overall);
   json["views"] = nlohmann::json::array();
   for (const DataTermMetrics& m : result.views) json["views"].push_back(ToJson(m));
-  const std::string output_path = options.output_path.empty()
-                                      ? JoinPaths(ws.StereoPath(), "evaluation")
-                                      : options.output_path;
-  result.json_path = JoinPaths(output_path, "data_term_evaluation.json");
-  const std::string text = json.dump(1);
-  WriteFileAtomically(result.json_path, [&text](std::ostream& out) { out << text << "\n"; },
-                      false);
+  result.json_path =
+      JoinPaths(EvaluationFolder(ws, options.output_path), "data_term_evaluation.json");
+  WriteJsonSummary(result.json_path, json);
   return result;
 }
 

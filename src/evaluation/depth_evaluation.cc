@@ -141,17 +141,11 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   std::string error;
   THROW_IF(!options.Check(&error), error);
   const Workspace ws = Workspace::Read(workspace_path);
-  std::vector<std::string> names = options.image_names;
-  if (names.empty()) {
-    for (const std::string& name : ws.ImageNames()) {
-      if (ExistsFile(ws.DepthMapPath(name, options.depth_type))) names.push_back(name);
-    }
-    THROW_IF(names.empty(), "No " << options.depth_type << " depth maps in "
-                                  << JoinPaths(ws.StereoPath(), "depth_maps"));
-  }
-  const std::string output_path = options.output_path.empty()
-                                      ? JoinPaths(ws.StereoPath(), "evaluation")
-                                      : options.output_path;
+  const std::vector<std::string> names = ViewsToEvaluate(
+      ws, options.image_names,
+      [&](const std::string& name) { return ws.DepthMapPath(name, options.depth_type); },
+      "No " + options.depth_type + " depth maps in " + JoinPaths(ws.StereoPath(), "depth_maps"));
+  const std::string output_path = EvaluationFolder(ws, options.output_path);
 
   DepthEvaluationResult result;
   DepthSamples pooled;
@@ -246,9 +240,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   json["views"] = nlohmann::json::array();
   for (const DepthMetrics& m : result.views) json["views"].push_back(ToJson(m));
   result.json_path = JoinPaths(output_path, "depth_evaluation.json");
-  const std::string text = json.dump(1);
-  WriteFileAtomically(result.json_path, [&text](std::ostream& out) { out << text << "\n"; },
-                      false);
+  WriteJsonSummary(result.json_path, json);
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "src/core/file_util.h"
 #include "src/core/logging.h"
 
 namespace hairmvs {
@@ -75,6 +76,27 @@ bool CheckImageNames(const std::vector<std::string>& names, std::string* error) 
     }
   }
   return true;
+}
+
+std::vector<std::string> ViewsToEvaluate(
+    const Workspace& ws, const std::vector<std::string>& requested,
+    const std::function<std::string(const std::string&)>& path_of, const std::string& none_found) {
+  if (!requested.empty()) return requested;
+  std::vector<std::string> names;
+  for (const std::string& name : ws.ImageNames()) {
+    if (ExistsFile(path_of(name))) names.push_back(name);
+  }
+  THROW_IF(names.empty(), none_found);
+  return names;
+}
+
+std::string EvaluationFolder(const Workspace& ws, const std::string& output_path) {
+  return output_path.empty() ? JoinPaths(ws.StereoPath(), "evaluation") : output_path;
+}
+
+void WriteJsonSummary(const std::string& path, const nlohmann::json& json) {
+  const std::string text = json.dump(1);
+  WriteFileAtomically(path, [&text](std::ostream& out) { out << text << "\n"; }, false);
 }
 
 }  // namespace hairmvs

@@ -1,9 +1,14 @@
 #pragma once
-// Small helpers shared by the evaluators: distance statistics and the median filter.
+// Small helpers shared by the evaluators: distance statistics, the median filter, which views
+// to read and where the summaries go.
 
+#include <nlohmann/json.hpp>
+
+#include <functional>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
 #include "src/core/float_map.h"
 
@@ -21,6 +26,16 @@ double Mean(const std::vector<double>& values);
 // window clamped at the image border), computed for every pixel, like
 // scipy.ndimage.median_filter(depth, k) up to its border rule.
 FloatMap MedianFilterValidDepths(const FloatMap& depth, int k, bool include_invalid = false);
+
+// The views a workspace evaluator reads: `requested` when given, else every image of the
+// workspace whose `path_of(name)` exists. Throws hairmvs::Error with `none_found` when none does.
+std::vector<std::string> ViewsToEvaluate(
+    const Workspace& ws, const std::vector<std::string>& requested,
+    const std::function<std::string(const std::string&)>& path_of, const std::string& none_found);
+// An evaluator's output folder: `output_path`, or <workspace>/stereo/evaluation when empty.
+std::string EvaluationFolder(const Workspace& ws, const std::string& output_path);
+// Writes an evaluator's JSON summary atomically (indented, newline-terminated).
+void WriteJsonSummary(const std::string& path, const nlohmann::json& json);
 
 // "Section.field" checks shared by the option structs.
 bool CheckImageNames(const std::vector<std::string>& names, std::string* error);

@@ -173,9 +173,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   json["completeness_2mm"] = result.completeness_2mm;
   json["completeness_5mm"] = result.completeness_5mm;
   json["num_views"] = names.size();
-  const std::string text = json.dump(1);
-  WriteFileAtomically(result.json_path, [&text](std::ostream& out) { out << text << "\n"; },
-                      false);
+  WriteJsonSummary(result.json_path, json);
   return result;
 }
 
