@@ -113,17 +113,17 @@ std::vector<StereoCamera> TCameras(const Eigen::Vector3d& target, double roll_ra
           LookAtCamera({0, -0.3, 0}, target, 100, 96, 72)};
 }
 
-// A plane 1 m in front of the reference, turned 0.35 rad about the vertical.
-Surface TiltedPlane() {
+// A plane 1 m in front of the reference, turned 0.35 rad about the vertical, reconstructed from
+// the T cameras with `options`.
+Result ReconstructTiltedPlane(const OrientationStereoOptions& options) {
   Surface plane;
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
-  return plane;
+  return Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
 }
 
 TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
-  const Surface plane = TiltedPlane();
-  const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
+  const Result result = ReconstructTiltedPlane(TestOptions());
   std::printf("plane: median |error| %.4f m, completeness %.3f\n", result.median_abs_error_m,
               result.completeness);
   EXPECT_LT(result.median_abs_error_m, 0.01);
@@ -133,11 +133,10 @@ TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
 // The coarse stage without level 0 (coarse_first_level 1, a speed option) still finds the
 // plane: the fine stage, with every level, refines what the coarser levels located.
 TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
-  const Surface plane = TiltedPlane();
   OrientationStereoOptions options = TestOptions();
   options.coarse_first_level = 1;
-  const Result result = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
-  const Result all_levels = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
+  const Result result = ReconstructTiltedPlane(options);
+  const Result all_levels = ReconstructTiltedPlane(TestOptions());
   std::printf("plane, coarse stage from level 1: median |error| %.4f m (all levels %.4f m), "
               "completeness %.3f\n",
               result.median_abs_error_m, all_levels.median_abs_error_m, result.completeness);
@@ -149,11 +148,10 @@ TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
 // --OrientationStereo.mrf_icm_polish_iterations reaches the solver: without the ICM polish
 // the semi-global labels keep a higher energy, and the plane is still recovered.
 TEST(DepthEstimator, IcmPolishLowersTheEnergyOfTheSemiGlobalLabels) {
-  const Surface plane = TiltedPlane();
   OrientationStereoOptions options = TestOptions();
   options.mrf_icm_polish_iterations = 0;
-  const Result without = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
-  const Result with = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, TestOptions(), 1);
+  const Result without = ReconstructTiltedPlane(options);
+  const Result with = ReconstructTiltedPlane(TestOptions());
   std::printf("plane: fine energy %.6g with 10 ICM sweeps, %.6g without; median %.4f / %.4f m\n",
               with.fine_energy, without.fine_energy, with.median_abs_error_m,
               without.median_abs_error_m);
