@@ -475,6 +475,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     DepthSearch computed;
     DepthSearch& search = cache != nullptr ? cache->search : computed;
     if (search.depth_max <= 0) {
+      // The other views' masks, for the range and the bound: copied out of the loader once.
+      std::vector<std::pair<StereoCamera, FloatMap>> masked_views;
+      auto others = [&]() -> const std::vector<std::pair<StereoCamera, FloatMap>>& {
+        if (masked_views.empty()) masked_views = loader.MaskedViews(name);
+        return masked_views;
+      };
       double depth_min = options.depth_min, depth_max = options.depth_max;
       std::string range_source = "options";
       if (depth_min <= 0 || depth_max <= 0) {
@@ -492,7 +498,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         double hull_min = 0, hull_max = 0;
         bool narrowed = false;
         if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
-            HullAndPointsDepthRange(ref.camera, mask, loader.MaskedViews(name),
+            HullAndPointsDepthRange(ref.camera, mask, others(),
                                     ComputeDepthRange(workspace.Model(), image_id), range,
                                     &hull_min, &hull_max, &narrowed, hull_options)) {
           range_source = narrowed ? "visual hull and sparse points in mask" : "visual hull";
@@ -512,7 +518,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         every_pixel_entries.find_far_ends = false;  // only the entry bounds the depth
         every_pixel_entries.min_carving_views = options.visual_hull_min_carving_views;
         const FloatMap intervals =
-            VisualHullIntervals(ref.camera, mask, loader.MaskedViews(name), 0.5 * depth_min,
+            VisualHullIntervals(ref.camera, mask, others(), 0.5 * depth_min,
                                 2 * depth_max, every_pixel_entries);
         search.depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
         for (size_t p = 0; p < intervals.NumPixels(); ++p) {
