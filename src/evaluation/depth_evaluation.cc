@@ -30,22 +30,47 @@ namespace {
 // The per-pixel samples of one view (or of all views pooled).
 struct DepthSamples {
   long num_hair_pixels = 0;
-  std::vector<double> abs_errors_m;   // hair pixels with a depth
+  // depth - true depth of the hair pixels with a depth, near the silhouette or not.
+  std::vector<double> silhouette_errors_m, interior_errors_m;
   std::vector<double> distances_3d_m;  // a subset of them, back-projected
+
+  void Append(const DepthSamples& other) {
+    num_hair_pixels += other.num_hair_pixels;
+    for (auto [to, from] : {std::pair(&silhouette_errors_m, &other.silhouette_errors_m),
+                            std::pair(&interior_errors_m, &other.interior_errors_m),
+                            std::pair(&distances_3d_m, &other.distances_3d_m)}) {
+      to->insert(to->end(), from->begin(), from->end());
+    }
+  }
 };
+
+// Median in mm of values in metres (signed or not; the median of an even count is the mean of
+// the middle two, as for the distances).
+double MedianMm(const std::vector<double>& values_m) {
+  return SummarizeDistances(values_m).median_mm;
+}
+
+std::vector<double> Absolute(std::vector<double> values) {
+  for (double& v : values) v = std::abs(v);
+  return values;
+}
 
 DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   DepthMetrics m;
   m.name = name;
   m.num_hair_pixels = samples.num_hair_pixels;
-  m.num_with_depth = static_cast<long>(samples.abs_errors_m.size());
+  std::vector<double> signed_errors_m = samples.silhouette_errors_m;
+  signed_errors_m.insert(signed_errors_m.end(), samples.interior_errors_m.begin(),
+                         samples.interior_errors_m.end());
+  const std::vector<double> abs_errors_m = Absolute(signed_errors_m);
+  m.num_with_depth = static_cast<long>(abs_errors_m.size());
   m.completeness = m.num_hair_pixels > 0 ? static_cast<double>(m.num_with_depth) / m.num_hair_pixels
                                          : 0.0;
-  const DistanceStats errors = SummarizeDistances(samples.abs_errors_m);
+  const DistanceStats errors = SummarizeDistances(abs_errors_m);
   m.mean_abs_error_mm = errors.mean_mm;
   m.median_abs_error_mm = errors.median_mm;
   long n1 = 0, n2 = 0, n5 = 0;
-  for (double e : samples.abs_errors_m) {
+  for (double e : abs_errors_m) {
     n1 += e <= 1e-3;
     n2 += e <= 2e-3;
     n5 += e <= 5e-3;
@@ -54,6 +79,12 @@ DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   m.within_1mm = n1 / n;
   m.within_2mm = n2 / n;
   m.within_5mm = n5 / n;
+  m.median_signed_error_mm = MedianMm(signed_errors_m);
+  m.silhouette_fraction = samples.silhouette_errors_m.size() / n;
+  m.silhouette_median_abs_error_mm = MedianMm(Absolute(samples.silhouette_errors_m));
+  m.silhouette_median_signed_error_mm = MedianMm(samples.silhouette_errors_m);
+  m.interior_median_abs_error_mm = MedianMm(Absolute(samples.interior_errors_m));
+  m.interior_median_signed_error_mm = MedianMm(samples.interior_errors_m);
   const DistanceStats accuracy = SummarizeDistances(samples.distances_3d_m);
   m.num_points_3d = accuracy.count;
   m.accuracy_3d_mean_mm = accuracy.mean_mm;
@@ -72,6 +103,12 @@ nlohmann::json ToJson(const DepthMetrics& m) {
           {"within_1mm", m.within_1mm},
           {"within_2mm", m.within_2mm},
           {"within_5mm", m.within_5mm},
+          {"median_signed_error_mm", m.median_signed_error_mm},
+          {"silhouette_fraction", m.silhouette_fraction},
+          {"silhouette_median_abs_error_mm", m.silhouette_median_abs_error_mm},
+          {"silhouette_median_signed_error_mm", m.silhouette_median_signed_error_mm},
+          {"interior_median_abs_error_mm", m.interior_median_abs_error_mm},
+          {"interior_median_signed_error_mm", m.interior_median_signed_error_mm},
           {"num_points_3d", m.num_points_3d},
           {"accuracy_3d_mean_mm", m.accuracy_3d_mean_mm},
           {"accuracy_3d_median_mm", m.accuracy_3d_median_mm},
@@ -81,10 +118,14 @@ nlohmann::json ToJson(const DepthMetrics& m) {
 std::string TableRow(const DepthMetrics& m) {
   char line[256];
   std::snprintf(line, sizeof(line),
-                "%-14s %9ld %7.1f%% %8.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %8.3f %8.3f\n",
+                "%-14s %9ld %7.1f%% %8.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %8.3f %8.3f %7.2f"
+                " %6.1f%% %7.2f %7.2f %7.2f %7.2f\n",
                 m.name.c_str(), m.num_hair_pixels, 100 * m.completeness, m.mean_abs_error_mm,
                 m.median_abs_error_mm, 100 * m.within_1mm, 100 * m.within_2mm,
-                100 * m.within_5mm, m.accuracy_3d_mean_mm, m.accuracy_3d_median_mm);
+                100 * m.within_5mm, m.accuracy_3d_mean_mm, m.accuracy_3d_median_mm,
+                m.median_signed_error_mm, 100 * m.silhouette_fraction,
+                m.silhouette_median_abs_error_mm, m.silhouette_median_signed_error_mm,
+                m.interior_median_abs_error_mm, m.interior_median_signed_error_mm);
   return line;
 }
 
@@ -103,6 +144,10 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
     *error = "EvaluateDepth.max_points_3d_per_view must be >= 0";
     return false;
   }
+  if (silhouette_band_px < 0) {
+    *error = "EvaluateDepth.silhouette_band_px must be >= 0";
+    return false;
+  }
   if (!(strand_spacing_m > 0)) {
     *error = "EvaluateDepth.strand_spacing_m must be > 0";
     return false;
@@ -112,8 +157,10 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
 
 std::string DepthEvaluationResult::Table() const {
   std::ostringstream out;
+  // sil = hair pixels within silhouette_band_px of the background, int = the others;
+  // signed medians (sgn) > 0: behind the truth.
   out << "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
-         "3d_med\n";
+         "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn\n";
   for (const DepthMetrics& m : views) out << TableRow(m);
   out << TableRow(overall);
   if (!json_path.empty()) out << "Summary: " << json_path << "\n";
@@ -170,6 +217,20 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const Eigen::Matrix3d R = image.R();
     const Eigen::Vector3d t = image.t();
 
+    // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in
+    // depth-map pixels scaled to gt pixels.
+    cv::Mat foreground(gt_height, gt_width, CV_8UC1);
+    for (int r = 0; r < gt_height; ++r) {
+      for (int c = 0; c < gt_width; ++c) {
+        foreground.at<uint8_t>(r, c) =
+            gt.label[static_cast<size_t>(r) * gt_width + c] == kLabelBackground ? 0 : 255;
+      }
+    }
+    cv::Mat distance_to_background;
+    cv::distanceTransform(foreground, distance_to_background, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    const double silhouette_band_gt_px =
+        options.silhouette_band_px * static_cast<double>(gt_width) / width;
+
     DepthSamples samples;
     std::vector<Eigen::Vector3d> points;
     // Error picture: black background, dark grey skin, grey = hair pixel without a depth,
@@ -194,8 +255,12 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
           pixel = cv::Vec3b(160, 160, 160);  // missing: grey
           continue;
         }
-        const double abs_error = std::abs(static_cast<double>(d) - gt.depth.At(gr, gc));
-        samples.abs_errors_m.push_back(abs_error);
+        const double signed_error = static_cast<double>(d) - gt.depth.At(gr, gc);
+        const bool near_silhouette =
+            distance_to_background.at<float>(gr, gc) <= silhouette_band_gt_px;
+        (near_silhouette ? samples.silhouette_errors_m : samples.interior_errors_m)
+            .push_back(signed_error);
+        const double abs_error = std::abs(signed_error);
         const double level = std::min(1.0, 1e3 * abs_error / options.error_image_max_mm);
         levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * level));
         has_depth.at<uint8_t>(r, c) = 255;
@@ -220,11 +285,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         THROW_IF(!cv::imwrite(tmp, error_image), "Cannot write " << png);
       });
     }
-    pooled.num_hair_pixels += samples.num_hair_pixels;
-    pooled.abs_errors_m.insert(pooled.abs_errors_m.end(), samples.abs_errors_m.begin(),
-                               samples.abs_errors_m.end());
-    pooled.distances_3d_m.insert(pooled.distances_3d_m.end(), samples.distances_3d_m.begin(),
-                                 samples.distances_3d_m.end());
+    pooled.Append(samples);
   }
   progress.Finish();
   result.overall = Summarize("overall", pooled);

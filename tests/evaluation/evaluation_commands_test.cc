@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
@@ -136,6 +137,7 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
   EXPECT_DOUBLE_EQ(result.overall.completeness, 1.0);
   EXPECT_NEAR(result.overall.mean_abs_error_mm, 0.0, 1e-9);
   EXPECT_DOUBLE_EQ(result.overall.within_1mm, 1.0);
+  EXPECT_NEAR(result.overall.median_signed_error_mm, 0.0, 1e-9);
   // On the plane of strands 0.1 mm apart: at most 0.05 mm from one (float depths: + ~1e-4 mm).
   EXPECT_LT(result.overall.accuracy_3d_mean_mm, 0.0502);
   EXPECT_GT(result.overall.accuracy_3d_mean_mm, 0.01);
@@ -198,6 +200,60 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
   }());
   EXPECT_LT(half_result.overall.mean_abs_error_mm, 1e-3);
   EXPECT_LT(half_result.overall.accuracy_3d_mean_mm, 0.0502);
+}
+
+TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
+  const Scene scene = MakeScene("silhouette");
+  const std::string out = JoinPaths(scene.dir, "shifted");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  // v0's depths 3 mm behind the truth within 4 px of the background, 1 mm in front further in;
+  // the distance to the nearest background pixel by brute force.
+  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v0.png");
+  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
+  FloatMap depth = ReadMat(v0);
+  long num_near = 0, num_hair = 0;
+  for (int r = 0; r < kHeight; ++r) {
+    for (int c = 0; c < kWidth; ++c) {
+      if (truth.label[r * kWidth + c] != kLabelHair) continue;
+      double nearest = std::numeric_limits<double>::infinity();
+      for (int br = 0; br < kHeight; ++br) {
+        for (int bc = 0; bc < kWidth; ++bc) {
+          if (truth.label[br * kWidth + bc] == kLabelBackground) {
+            nearest = std::min(nearest, std::hypot(br - r, bc - c));
+          }
+        }
+      }
+      const bool near = nearest <= 4.0;
+      depth.At(r, c) += near ? 3e-3f : -1e-3f;
+      num_near += near;
+      ++num_hair;
+    }
+  }
+  WriteMat(v0, depth);
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v0.png"};
+  options.silhouette_band_px = 4;
+  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, options);
+  const DepthMetrics& m = result.overall;
+  ASSERT_EQ(m.num_with_depth, num_hair);
+  ASSERT_GT(num_near, num_hair / 4);
+  ASSERT_LT(num_near, num_hair / 2);
+  EXPECT_NEAR(m.silhouette_fraction, static_cast<double>(num_near) / num_hair, 1e-12);
+  EXPECT_NEAR(m.silhouette_median_signed_error_mm, 3.0, 1e-3);  // float depths
+  EXPECT_NEAR(m.silhouette_median_abs_error_mm, 3.0, 1e-3);
+  EXPECT_NEAR(m.interior_median_signed_error_mm, -1.0, 1e-3);
+  EXPECT_NEAR(m.interior_median_abs_error_mm, 1.0, 1e-3);
+  // Most pixels are inside: the overall signed median is theirs.
+  EXPECT_NEAR(m.median_signed_error_mm, -1.0, 1e-3);
+  EXPECT_NEAR(m.median_abs_error_mm, 1.0, 1e-3);
+  const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
+  EXPECT_NEAR(json["overall"]["silhouette_median_signed_error_mm"].get<double>(), 3.0, 1e-3);
+  EXPECT_NE(result.Table().find("sil_med"), std::string::npos);
+
+  options.silhouette_band_px = -1;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("silhouette_band_px"), std::string::npos) << error;
 }
 
 // Writes a cost volume for v0 on a 16 x 12 grid (4 x 4 image pixels each) with labels 5 mm
