@@ -59,6 +59,22 @@ void SmoothnessWeights(const FloatMap& orientation, double lambda, double sigma_
   }
 }
 
+FloatMap ScaleToRms(const FloatMap& field, double rms) {
+  double sum_sq = 0;
+  long count = 0;
+  for (size_t i = 0; i < field.NumPixels(); ++i) {
+    double sq = 0;
+    for (int c = 0; c < field.Channels(); ++c) sq += field.Channel(c)[i] * field.Channel(c)[i];
+    sum_sq += sq;
+    count += sq > 0;
+  }
+  FloatMap scaled = field;
+  if (count == 0) return scaled;
+  const float factor = static_cast<float>(rms / std::sqrt(sum_sq / count));
+  for (float& v : scaled.Data()) v *= factor;
+  return scaled;
+}
+
 namespace {
 
 // Per-level machinery of one reference view.
@@ -243,6 +259,12 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   cl::CommandQueue& queue = context->Queue();
   const MrfSolverOptions mrf_options = MakeMrfOptions(options);
 
+  // The guide of the aggregation and of the smoothness weights (see guide_rms).
+  std::vector<FloatMap> guides;
+  for (int l = 0; l < num_levels; ++l) {
+    guides.push_back(options.guide_rms > 0 ? ScaleToRms(ref.orientation[l], options.guide_rms)
+                                           : ref.orientation[l]);
+  }
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
@@ -267,7 +289,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     ScopedStageTimer timer(timings, "aggregation");
     for (int l = 0; l < num_levels; ++l) {
       levels[l].filter = std::make_unique<GuidedFilterCL>(
-          context, ref.orientation[l], options.WindowPx(l) / 2,
+          context, guides[l], options.WindowPx(l) / 2,
           static_cast<float>(options.guided_filter_eps));
     }
     queue.finish();
@@ -333,7 +355,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     problem.label_offset = std::move(offset);
     problem.label_step = step;
     problem.truncation = static_cast<float>(truncation);
-    SmoothnessWeights(ref.orientation[grid_level], options.lambda, options.sigma_o,
+    SmoothnessWeights(guides[grid_level], options.lambda, options.sigma_o,
                       &problem.weight_right, &problem.weight_down);
     MrfResult result = SolveMrf(problem, mrf_options, context);
     *energy = result.energy;

@@ -35,6 +35,10 @@ struct StereoViewData {
 // correlation of the orientation textures (a zero-mean NCC of the complex fields).
 FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps);
 
+// `field` scaled so that the RMS magnitude of its non-zero pixels is `rms` (unchanged when all
+// are zero).
+FloatMap ScaleToRms(const FloatMap& field, double rms);
+
 struct DepthEstimate {
   FloatMap depth;       // z-depth on the level-0 grid, 0 = invalid
   FloatMap confidence;  // aggregated cost margin (second-best minus best), level-0 grid

@@ -196,6 +196,23 @@ TEST(DepthEstimator, EpipoleRollCorrectionIsNeededForARolledSource) {
 namespace hairmvs {
 namespace {
 
+// The guide's scaling: the non-zero pixels' RMS magnitude becomes the target, directions and
+// zeros stay; an all-zero field stays as it is.
+TEST(ScaleToRms, NonZeroPixelsGetTheTargetRms) {
+  FloatMap field(3, 2, 2, 0.0f);
+  field.At(0, 0, 0) = 3;  // |O| = 5
+  field.At(0, 0, 1) = 4;
+  field.At(1, 2, 1) = -5;  // |O| = 5; four pixels stay 0
+  const FloatMap scaled = ScaleToRms(field, 2.0);
+  EXPECT_FLOAT_EQ(scaled.At(0, 0, 0), 1.2f);
+  EXPECT_FLOAT_EQ(scaled.At(0, 0, 1), 1.6f);
+  EXPECT_FLOAT_EQ(scaled.At(1, 2, 1), -2.0f);
+  EXPECT_EQ(scaled.At(0, 1, 0), 0.0f);
+  EXPECT_EQ(scaled.At(1, 1, 1), 0.0f);
+  const FloatMap zeros(4, 4, 2, 0.0f);
+  EXPECT_EQ(ScaleToRms(zeros, 1.0).Data(), zeros.Data());
+}
+
 // The local normalisation against explicit window sums: zero mean and unit variance (up to
 // eps) over each window of valid pixels; masked (zero) pixels stay zero.
 TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {

@@ -142,6 +142,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "window_px_level* must be >= 1; ";
   }
   if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
+  if (!(guide_rms >= 0)) e << "guide_rms must be >= 0; ";
   if (!(sigma_o > 0)) e << "sigma_o must be > 0; ";
   if (!(lambda >= 0)) e << "lambda must be >= 0; ";
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
