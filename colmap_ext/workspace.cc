@@ -40,7 +40,28 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
   } else if (ExistsDir(JoinPaths(path, "masks"))) {
     ws.mask_path_ = JoinPaths(path, "masks");
   }
+  const std::vector<std::string> unmasked = ws.ImagesWithoutMask();
+  if (!unmasked.empty()) {
+    // COLMAP skips a missing mask silently; here a view without one lets its background into
+    // the depth range and the depth map, so say which.
+    std::ostringstream names;
+    for (size_t i = 0; i < unmasked.size() && i < 5; ++i) names << (i ? ", " : "") << unmasked[i];
+    if (unmasked.size() > 5) names << ", ...";
+    LOG(WARNING) << ws.mask_path_ << ": no mask for " << unmasked.size() << " of "
+                 << ws.image_names_.size() << " images (" << names.str() << "; expected "
+                 << JoinPaths(ws.mask_path_, "<image name>.png")
+                 << "): they are processed without a mask";
+  }
   return ws;
+}
+
+std::vector<std::string> Workspace::ImagesWithoutMask() const {
+  std::vector<std::string> names;
+  if (mask_path_.empty()) return names;
+  for (const std::string& name : image_names_) {
+    if (MaskPath(name).empty()) names.push_back(name);
+  }
+  return names;
 }
 
 int Workspace::ImageIdx(const std::string& name) const {

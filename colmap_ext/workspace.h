@@ -31,6 +31,8 @@ class Workspace {
   std::string ImagePath(const std::string& name) const;
   // "" when the workspace has no masks or this image has none.
   std::string MaskPath(const std::string& name) const;
+  // With a masks folder, the images that have no mask in it (Read warns about them).
+  std::vector<std::string> ImagesWithoutMask() const;
   std::string StereoPath() const;
   // type: "geometric" or "photometric".
   std::string DepthMapPath(const std::string& name, const std::string& type = "geometric") const;

@@ -38,6 +38,7 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_THROW(ws.DepthMapPath("a.png", "geometrical"), Error);
   EXPECT_EQ(ws.MaskPath("a.png"), "");
   EXPECT_EQ(ws.MaskPath("b.png"), JoinPaths(dir, "masks", "b.png.png"));
+  EXPECT_EQ(ws.ImagesWithoutMask(), (std::vector<std::string>{"a.png", "c.png"}));
   EXPECT_NE(ws.OrientationMapPath("a.png", 0), ws.OrientationMapPath("a.png", 1));
 
   // An explicit mask folder; 3.12+ naming (the name itself when it ends in .png).
@@ -47,6 +48,7 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   const Workspace ws2 = Workspace::Read(dir, other_masks);
   EXPECT_EQ(ws2.MaskPath("a.png"), JoinPaths(other_masks, "a.png"));
   EXPECT_EQ(ws2.MaskPath("b.png"), "");
+  EXPECT_EQ(ws2.ImagesWithoutMask(), (std::vector<std::string>{"b.png", "c.png"}));
   EXPECT_NE(ErrorOf([&] { Workspace::Read(dir, JoinPaths(dir, "nomasks")); }).find("nomasks"),
             std::string::npos);
 }
