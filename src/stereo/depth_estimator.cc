@@ -260,11 +260,13 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const MrfSolverOptions mrf_options = MakeMrfOptions(options);
 
   // The guide of the aggregation and of the smoothness weights (see guide_rms).
-  std::vector<FloatMap> guides;
-  for (int l = 0; l < num_levels; ++l) {
-    guides.push_back(options.guide_rms > 0 ? ScaleToRms(ref.orientation[l], options.guide_rms)
-                                           : ref.orientation[l]);
+  std::vector<FloatMap> scaled_guides;
+  for (int l = 0; l < num_levels && options.guide_rms > 0; ++l) {
+    scaled_guides.push_back(ScaleToRms(ref.orientation[l], options.guide_rms));
   }
+  auto guide = [&](int l) -> const FloatMap& {
+    return scaled_guides.empty() ? ref.orientation[l] : scaled_guides[l];
+  };
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
@@ -289,7 +291,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     ScopedStageTimer timer(timings, "aggregation");
     for (int l = 0; l < num_levels; ++l) {
       levels[l].filter = std::make_unique<GuidedFilterCL>(
-          context, guides[l], options.WindowPx(l) / 2,
+          context, guide(l), options.WindowPx(l) / 2,
           static_cast<float>(options.guided_filter_eps));
     }
     queue.finish();
@@ -355,7 +357,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     problem.label_offset = std::move(offset);
     problem.label_step = step;
     problem.truncation = static_cast<float>(truncation);
-    SmoothnessWeights(guides[grid_level], options.lambda, options.sigma_o,
+    SmoothnessWeights(guide(grid_level), options.lambda, options.sigma_o,
                       &problem.weight_right, &problem.weight_down);
     MrfResult result = SolveMrf(problem, mrf_options, context);
     *energy = result.energy;
