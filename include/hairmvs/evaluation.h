@@ -92,7 +92,8 @@ struct DepthEvaluationOptions {
     v("depth_type", &depth_type, "geometric or photometric");
     v("image_names", &image_names, "views to evaluate (comma-separated; empty = all)");
     v("output_path", &output_path, "folder for error pictures and JSON (default W/stereo/evaluation)");
-    v("write_error_images", &write_error_images, "write <name>.error.png per view");
+    v("write_error_images", &write_error_images,
+      "write <name>.error.png and <name>.signed_error.png per view");
     v("error_image_max_mm", &error_image_max_mm, "error at the red end of the colour scale (mm)");
     v("max_points_3d_per_view", &max_points_3d_per_view,
       "subsample the 3D accuracy to this many pixels per view (0 = all)");

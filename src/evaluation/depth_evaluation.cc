@@ -233,10 +233,13 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
 
     DepthSamples samples;
     std::vector<Eigen::Vector3d> points;
-    // Error picture: black background, dark grey skin, grey = hair pixel without a depth,
-    // colour = error level of a hair pixel with a depth (blue 0 mm .. red error_image_max_mm).
+    // Error pictures: black background, dark grey skin, grey = hair pixel without a depth;
+    // a hair pixel with a depth: its |error| (blue 0 mm .. red error_image_max_mm), and in the
+    // signed picture its signed error (blue in front, white 0, red behind, saturated at
+    // error_image_max_mm).
     cv::Mat error_image(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
     cv::Mat levels(height, width, CV_8UC1, cv::Scalar(0));
+    cv::Mat signed_levels(height, width, CV_32FC1, cv::Scalar(0));
     cv::Mat has_depth(height, width, CV_8UC1, cv::Scalar(0));
     for (int r = 0; r < height; ++r) {
       const int gr = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
@@ -263,6 +266,8 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         const double abs_error = std::abs(signed_error);
         const double level = std::min(1.0, 1e3 * abs_error / options.error_image_max_mm);
         levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * level));
+        signed_levels.at<float>(r, c) = static_cast<float>(
+            std::clamp(1e3 * signed_error / options.error_image_max_mm, -1.0, 1.0));
         has_depth.at<uint8_t>(r, c) = 255;
         points.push_back(R.transpose() * (BackProjectPixel(K, c, r, d) - t));
       }
@@ -277,13 +282,26 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     result.views.push_back(Summarize(name, samples));
 
     if (options.write_error_images) {
+      cv::Mat signed_image = error_image.clone();
+      for (int r = 0; r < height; ++r) {
+        for (int c = 0; c < width; ++c) {
+          if (!has_depth.at<uint8_t>(r, c)) continue;
+          const float level = signed_levels.at<float>(r, c);
+          const auto fade = static_cast<uint8_t>(std::lround(255 * (1 - std::abs(level))));
+          signed_image.at<cv::Vec3b>(r, c) =  // BGR
+              level > 0 ? cv::Vec3b(fade, fade, 255) : cv::Vec3b(255, fade, fade);
+        }
+      }
       cv::Mat colours;
       cv::applyColorMap(levels, colours, cv::COLORMAP_JET);
       colours.copyTo(error_image, has_depth);
-      const std::string png = JoinPaths(output_path, name + ".error.png");
-      WritePathAtomically(png, [&](const std::string& tmp) {
-        THROW_IF(!cv::imwrite(tmp, error_image), "Cannot write " << png);
-      });
+      for (const auto& [suffix, image] : {std::pair(".error.png", &error_image),
+                                          std::pair(".signed_error.png", &signed_image)}) {
+        const std::string png = JoinPaths(output_path, name + suffix);
+        WritePathAtomically(png, [&](const std::string& tmp) {
+          THROW_IF(!cv::imwrite(tmp, *image), "Cannot write " << png);
+        });
+      }
     }
     pooled.Append(samples);
   }

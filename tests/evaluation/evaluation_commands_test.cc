@@ -249,6 +249,22 @@ TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
   const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
   EXPECT_NEAR(json["overall"]["silhouette_median_signed_error_mm"].get<double>(), 3.0, 1e-3);
   EXPECT_NE(result.Table().find("sil_med"), std::string::npos);
+  // The signed picture (BGR; float depths: +-1 per channel): 3 mm behind of the 10 mm scale
+  // is light red, 1 mm in front light blue.
+  const cv::Mat signed_image = cv::imread(
+      JoinPaths(out, "stereo", "evaluation", "v0.png.signed_error.png"), cv::IMREAD_COLOR);
+  ASSERT_FALSE(signed_image.empty());
+  auto expect_colour = [&](int r, int c, cv::Vec3b expected) {
+    const cv::Vec3b actual = signed_image.at<cv::Vec3b>(r, c);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(actual[k], expected[k], 1) << r << " " << c;
+  };
+  expect_colour(kHeight / 2, kWidth / 2, cv::Vec3b(255, 230, 230));
+  for (int c = 0; c < kWidth; ++c) {  // the first hair pixel of the middle row is near
+    if (truth.label[(kHeight / 2) * kWidth + c] != kLabelHair) continue;
+    expect_colour(kHeight / 2, c, cv::Vec3b(179, 179, 255));
+    break;
+  }
+  expect_colour(0, 0, cv::Vec3b(0, 0, 0));  // background
 
   options.silhouette_band_px = -1;
   std::string error;
