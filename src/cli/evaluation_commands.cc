@@ -71,10 +71,14 @@ int RunEvaluateDepth(int argc, char** argv) {
   return RunWorkspaceEvaluation<DepthEvaluationOptions>(
       argc, argv, "evaluate_depth",
       "Compares a workspace's depth maps with the true ones on the hair pixels (label 2): "
-      "absolute error (mean, median, fraction within 1/2/5 mm), completeness, and 3D accuracy "
+      "absolute error (mean, median, fraction within 1/2/5 mm), completeness, 3D accuracy "
       "(pixels back-projected with the workspace's cameras, distance to the nearest true "
-      "strand). Writes <output>/<name>.error.png and <output>/depth_evaluation.json.",
+      "strand), the median signed error (> 0 behind the truth), and the median absolute and "
+      "signed errors apart within --silhouette_band_px of the background and further in. "
+      "Writes <output>/<name>.error.png, <output>/<name>.signed_error.png and "
+      "<output>/depth_evaluation.json.",
       "dense workspace with depth maps",
+      // A lambda: EvaluateDepthMaps is overloaded (also with a prebuilt strand index).
       [](const std::string& workspace, const std::string& truth,
          const DepthEvaluationOptions& options) {
         return EvaluateDepthMaps(workspace, truth, options);

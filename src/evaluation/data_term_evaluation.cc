@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <utility>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/workspace.h"
@@ -26,6 +27,16 @@ struct DataTermSamples {
   std::vector<double> label_errors;    // |cheapest label - true label position|
   std::vector<double> label_steps_m;   // depth step between the labels around the truth
   std::vector<double> true_depth_ranks;
+
+  void Append(const DataTermSamples& other) {
+    num_outside_range += other.num_outside_range;
+    for (auto [to, from] : {std::pair(&abs_errors_m, &other.abs_errors_m),
+                            std::pair(&label_errors, &other.label_errors),
+                            std::pair(&label_steps_m, &other.label_steps_m),
+                            std::pair(&true_depth_ranks, &other.true_depth_ranks)}) {
+      to->insert(to->end(), from->begin(), from->end());
+    }
+  }
 };
 
 DataTermMetrics Summarize(const std::string& name, const DataTermSamples& samples) {
@@ -144,17 +155,6 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt, double mi
   }
 }
 
-void Append(const DataTermSamples& from, DataTermSamples* to) {
-  to->num_outside_range += from.num_outside_range;
-  auto append = [](const std::vector<double>& a, std::vector<double>* b) {
-    b->insert(b->end(), a.begin(), a.end());
-  };
-  append(from.abs_errors_m, &to->abs_errors_m);
-  append(from.label_errors, &to->label_errors);
-  append(from.label_steps_m, &to->label_steps_m);
-  append(from.true_depth_ranks, &to->true_depth_ranks);
-}
-
 }  // namespace
 
 bool DataTermEvaluationOptions::Check(std::string* error) const {
@@ -198,7 +198,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
     EvaluateView(volume, ReadGroundTruthView(ground_truth_path, name),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
-    Append(samples, &pooled);
+    pooled.Append(samples);
   }
   progress.Finish();
   result.overall = Summarize("overall", pooled);

@@ -12,6 +12,7 @@
 #include <iomanip>
 #include <random>
 #include <sstream>
+#include <utility>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/workspace.h"

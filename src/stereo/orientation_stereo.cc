@@ -491,7 +491,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                      : ComputeDepthRange(workspace.Model(), image_id);
         if (depth_min <= 0) depth_min = range.min_m;
         if (depth_max <= 0) depth_max = range.max_m;
-        range_source = options.depth_range_from_mask ? "sparse in mask" : "sparse";
+        range_source = range.inside_mask ? "sparse in mask" : "sparse";
         // The masks' visual hull: the sparse points of a textured room say little about the
         // head, and those in the mask may be wrong too.
         VisualHullRangeOptions hull_options;
@@ -500,8 +500,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         bool narrowed = false;
         if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
             HullAndPointsDepthRange(ref.camera, mask, others(),
-                                    ComputeDepthRange(workspace.Model(), image_id), range,
-                                    &hull_min, &hull_max, &narrowed, hull_options)) {
+                                    // Without points in the mask, `range` has all of them.
+                                    range.inside_mask
+                                        ? ComputeDepthRange(workspace.Model(), image_id)
+                                        : range,
+                                    range, &hull_min, &hull_max, &narrowed, hull_options)) {
           range_source = narrowed ? "visual hull and sparse points in mask" : "visual hull";
           if (options.depth_min <= 0) depth_min = hull_min;
           if (options.depth_max <= 0) depth_max = hull_max;
