@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <sstream>
 #include <utility>
 
 #include "colmap_ext/mat_io.h"
@@ -166,12 +165,9 @@ bool DataTermEvaluationOptions::Check(std::string* error) const {
 }
 
 std::string DataTermEvaluationResult::Table() const {
-  std::ostringstream out;
-  out << "view             pixels outside step_mm  med_mm  <=1lab  <=5mm <=10mm  rank\n";
-  for (const DataTermMetrics& m : views) out << TableRow(m);
-  out << TableRow(overall);
-  if (!json_path.empty()) out << "Summary: " << json_path << "\n";
-  return out.str();
+  return EvaluationTable(
+      "view             pixels outside step_mm  med_mm  <=1lab  <=5mm <=10mm  rank\n", views,
+      overall, json_path, TableRow);
 }
 
 DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,

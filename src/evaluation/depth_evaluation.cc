@@ -11,7 +11,6 @@
 #include <cstdio>
 #include <iomanip>
 #include <random>
-#include <sstream>
 #include <utility>
 
 #include "colmap_ext/mat_io.h"
@@ -157,15 +156,12 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
 }
 
 std::string DepthEvaluationResult::Table() const {
-  std::ostringstream out;
   // sil = hair pixels within silhouette_band_px of the background, int = the others;
   // signed medians (sgn) > 0: behind the truth.
-  out << "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
-         "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn\n";
-  for (const DepthMetrics& m : views) out << TableRow(m);
-  out << TableRow(overall);
-  if (!json_path.empty()) out << "Summary: " << json_path << "\n";
-  return out.str();
+  return EvaluationTable(
+      "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
+      "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn\n",
+      views, overall, json_path, TableRow);
 }
 
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,

@@ -37,6 +37,18 @@ std::string EvaluationFolder(const Workspace& ws, const std::string& output_path
 // Writes an evaluator's JSON summary atomically (indented, newline-terminated).
 void WriteJsonSummary(const std::string& path, const nlohmann::json& json);
 
+// An evaluator's printed table: `header`, `row(m)` per view and for the overall metrics, and
+// where the JSON summary went.
+template <typename Metrics, typename RowFn>
+std::string EvaluationTable(const std::string& header, const std::vector<Metrics>& views,
+                            const Metrics& overall, const std::string& json_path, RowFn row) {
+  std::string table = header;
+  for (const Metrics& m : views) table += row(m);
+  table += row(overall);
+  if (!json_path.empty()) table += "Summary: " + json_path + "\n";
+  return table;
+}
+
 // "Section.field" checks shared by the option structs.
 bool CheckImageNames(const std::vector<std::string>& names, std::string* error);
 
