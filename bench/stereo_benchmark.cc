@@ -27,7 +27,11 @@ void BM_OrientationCostVolume(benchmark::State& state) {
     sources.push_back({LookAtCamera(centers[v], {0, 0, 0.6}, 768, kWidth, kHeight),
                        RandomMap(kWidth, kHeight, 2, 2 + v)});
   }
-  CostVolumeCL volume(context.get(), StereoCost::kOrientation, ref, sources);
+  // Argument 0: the paper's epipole roll; 1: the plane homography (the default).
+  const OrientationTransfer transfer = state.range(0) == 0
+                                           ? OrientationTransfer::kEpipoleRoll
+                                           : OrientationTransfer::kPlaneHomography;
+  CostVolumeCL volume(context.get(), StereoCost::kOrientation, ref, sources, transfer);
   const DepthLabels labels(0.4, 0.8, 64, true);
   std::vector<float> base(kWidth * kHeight, 0.0f);
   cl::Buffer base_buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
@@ -41,7 +45,8 @@ void BM_OrientationCostVolume(benchmark::State& state) {
   state.counters["Mpixel_slices/s"] = benchmark::Counter(
       1e-6 * kWidth * kHeight * kSlices, benchmark::Counter::kIsIterationInvariantRate);
 }
-BENCHMARK(BM_OrientationCostVolume)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OrientationCostVolume)->ArgName("plane_homography")->Arg(0)->Arg(1)->Unit(
+    benchmark::kMillisecond);
 
 void BM_GuidedFilter(benchmark::State& state) {
   auto context = OpenCLContext::Create();

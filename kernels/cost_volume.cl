@@ -6,8 +6,10 @@
 //   D = inverse_depth ? 1 / t : t.
 // Projection into source view j (SfM pixel convention, at the level's resolution):
 //   u = D * (Hj * (col + 0.5, row + 0.5, 1)) + bj, sample at (u.x / u.z - 0.5, u.y / u.z - 0.5).
-// view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), 0, 0 with
-// psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5.
+// view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), homography,
+// 0 with psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5. homography = 1: the
+// reference orientation is instead carried into view j by the Jacobian of the fronto-parallel
+// plane's homography at the pixel (TransferDirection in src/stereo/stereo_geometry.h).
 // view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
 // The reference orientation field is planar (Re plane, then Im plane); the source fields are
 // interleaved (Re, Im per pixel), since they are sampled at scattered points.
@@ -88,10 +90,24 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
       int valid;
       const float2 o = Bilinear2(src, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
       if (!valid) continue;
-      // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
-      const float re = ore * o.x + oim * o.y;
-      const float im = ore * o.y - oim * o.x;
-      total -= re * m[12] - im * m[13];
+      if (m[14] != 0.0f) {
+        // O_ref = r exp(2i theta): the direction (cos theta, sin theta) through the Jacobian
+        // (up to a positive factor) gives theta' and the carried O' = r exp(2i theta').
+        const float px = ux / uz, py = uy / uz;
+        const float r = sqrt(ore * ore + oim * oim);
+        const float c2 = ore / r;
+        const float ct = sqrt(fmax(0.0f, 0.5f * (1.0f + c2)));
+        const float st = copysign(sqrt(fmax(0.0f, 0.5f * (1.0f - c2))), oim);
+        const float dx = (m[0] - px * m[6]) * ct + (m[1] - px * m[7]) * st;
+        const float dy = (m[3] - py * m[6]) * ct + (m[4] - py * m[7]) * st;
+        const float scale = r / (dx * dx + dy * dy);
+        total -= scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
+      } else {
+        // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
+        const float re = ore * o.x + oim * o.y;
+        const float im = ore * o.y - oim * o.x;
+        total -= re * m[12] - im * m[13];
+      }
     }
   }
   cost[(size_t)k * plane + p] = total;

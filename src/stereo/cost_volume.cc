@@ -32,13 +32,14 @@ bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double
   return true;
 }
 
-// Where the reference pixel (col, row) of the ref field's grid at depth D lands in the source
-// field's grid (pixel-centre coordinates), through the world frame. False behind the camera.
-bool ProjectCpu(const CostViewInput& ref, const CostViewInput& src, int col, int row,
+// Where the reference image point (x_ref, y_ref) of the ref field's grid (SfM: pixel (col, row)
+// is (col + 0.5, row + 0.5)) at depth D lands in the source field's grid (pixel-centre
+// coordinates: pixel centres at integers), through the world frame. False behind the camera.
+bool ProjectCpu(const CostViewInput& ref, const CostViewInput& src, double x_ref, double y_ref,
                 double depth, double* x, double* y) {
   const StereoCamera r = ref.camera.Scaled(ref.field.Width(), ref.field.Height());
   const StereoCamera s = src.camera.Scaled(src.field.Width(), src.field.Height());
-  const Eigen::Vector3d ray = r.K.inverse() * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+  const Eigen::Vector3d ray = r.K.inverse() * Eigen::Vector3d(x_ref, y_ref, 1.0);
   const Eigen::Vector3d world = r.R.transpose() * (depth * ray - r.t);
   const Eigen::Vector3d u = s.K * (s.R * world + s.t);
   if (u.z() <= 0) return false;
@@ -50,8 +51,8 @@ bool ProjectCpu(const CostViewInput& ref, const CostViewInput& src, int col, int
 }  // namespace
 
 CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostViewInput& ref,
-                           const std::vector<CostViewInput>& sources, bool roll_correction,
-                           int ncc_radius)
+                           const std::vector<CostViewInput>& sources,
+                           OrientationTransfer transfer, int ncc_radius)
     : context_(context), cost_(cost), width_(ref.field.Width()), height_(ref.field.Height()),
       num_views_(static_cast<int>(sources.size())), ncc_radius_(ncc_radius) {
   const int expected_channels = cost == StereoCost::kOrientation ? 2 : 3;
@@ -64,7 +65,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     CHECK_EQ(src.field.Channels(), expected_channels);
     const ViewProjection projection =
         ComputeViewProjection(ref.camera, width_, height_, src.camera, src.field.Width(),
-                              src.field.Height(), roll_correction);
+                              src.field.Height(), transfer);
     const auto packed = projection.Packed();
     params.insert(params.end(), packed.begin(), packed.end());
     dims.insert(dims.end(), {src.field.Width(), src.field.Height(),
@@ -198,12 +199,12 @@ FloatMap CostVolumeCL::Compute(const std::vector<float>& label_base, float label
 FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
                             const std::vector<float>& label_base, float label_step,
                             int slice_begin, int num_slices, const DepthLabels& labels,
-                            bool roll_correction) {
+                            OrientationTransfer transfer) {
   const int w = ref.field.Width(), h = ref.field.Height();
   FloatMap out(w, h, num_slices);
   std::vector<double> psi(sources.size(), 0.0);
   for (size_t v = 0; v < sources.size(); ++v) {
-    if (roll_correction) {
+    if (transfer == OrientationTransfer::kEpipoleRoll) {
       psi[v] = 2.0 * (EpipoleAngle(ref.camera, sources[v].camera.Center()) -
                       EpipoleAngle(sources[v].camera, ref.camera.Center()));
     }
@@ -214,14 +215,27 @@ FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostView
         const std::complex<double> o_ref(ref.field.At(row, col, 0), ref.field.At(row, col, 1));
         const double label = label_base[row * w + col] + (slice_begin + k) * label_step;
         const double depth = labels.Depth(label);
+        const double x_ref = col + 0.5, y_ref = row + 0.5;
         double total = 0;
         for (size_t v = 0; v < sources.size(); ++v) {
           double x, y, re, im = 0;
-          if (!ProjectCpu(ref, sources[v], col, row, depth, &x, &y)) continue;
+          if (!ProjectCpu(ref, sources[v], x_ref, y_ref, depth, &x, &y)) continue;
           if (!SampleBilinear(sources[v].field, 0, x, y, &re)) continue;
           SampleBilinear(sources[v].field, 1, x, y, &im);
           const std::complex<double> o_src(re, im);
-          total -= (std::conj(o_ref) * o_src * std::polar(1.0, psi[v])).real();
+          std::complex<double> carried = o_ref * std::polar(1.0, -psi[v]);
+          if (transfer == OrientationTransfer::kPlaneHomography && std::abs(o_ref) > 0) {
+            // The strand through the pixel at angle theta = arg(O_ref) / 2, kept at the same
+            // depth (the fronto-parallel plane): project a short piece of it, both ways.
+            const double theta = 0.5 * std::arg(o_ref), step = 1e-3;
+            double xa, ya, xb, yb;
+            ProjectCpu(ref, sources[v], x_ref - step * std::cos(theta),
+                       y_ref - step * std::sin(theta), depth, &xa, &ya);
+            ProjectCpu(ref, sources[v], x_ref + step * std::cos(theta),
+                       y_ref + step * std::sin(theta), depth, &xb, &yb);
+            carried = std::polar(std::abs(o_ref), 2.0 * std::atan2(yb - ya, xb - xa));
+          }
+          total -= (std::conj(carried) * o_src).real();
         }
         out.At(row, col, k) = static_cast<float>(total);
       }
@@ -246,7 +260,7 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
           const double depth =
               labels.Depth(label_base[row * w + col] + (slice_begin + k) * label_step);
           double x, y, value;
-          if (!ProjectCpu(ref, sources[v], col, row, depth, &x, &y)) continue;
+          if (!ProjectCpu(ref, sources[v], col + 0.5, row + 0.5, depth, &x, &y)) continue;
           if (!SampleBilinear(sources[v].field, 0, x, y, &value)) continue;
           valid[row * w + col] = 1;
           for (int c = 0; c < 3; ++c) {

@@ -31,7 +31,7 @@ struct CostViewInput {
 class CostVolumeCL {
  public:
   CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostViewInput& ref,
-               const std::vector<CostViewInput>& sources, bool roll_correction = true,
+               const std::vector<CostViewInput>& sources, OrientationTransfer transfer,
                int ncc_radius = 3);
   int Width() const { return width_; }
   int Height() const { return height_; }
@@ -74,7 +74,7 @@ class CostVolumeCL {
 FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
                             const std::vector<float>& label_base, float label_step,
                             int slice_begin, int num_slices, const DepthLabels& labels,
-                            bool roll_correction = true);
+                            OrientationTransfer transfer);
 FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostViewInput>& sources,
                             const std::vector<float>& label_base, float label_step,
                             int slice_begin, int num_slices, const DepthLabels& labels,

@@ -43,19 +43,29 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
   auto context = OpenCLContext::Create();
   const Scene scene = MakeScene(2);
   const DepthLabels labels(0.6, 2.0, 32, true);
-  for (bool roll : {true, false}) {
-    CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources, roll);
+  for (OrientationTransfer transfer :
+       {OrientationTransfer::kEpipoleRoll, OrientationTransfer::kNone,
+        OrientationTransfer::kPlaneHomography}) {
+    CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources,
+                        transfer);
     const FloatMap got = volume.Compute(scene.base, 0.75f, 5, 7, labels);
     const FloatMap expected =
-        OrientationCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 7, labels, roll);
-    EXPECT_LT(MaxAbsDiff(got, expected), 2e-4f);
+        OrientationCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 7, labels, transfer);
+    EXPECT_LT(MaxAbsDiff(got, expected), 2e-4f) << ToString(transfer);
   }
+  // The transfers differ on this scene (a rolled source and one above), so each is checked.
+  const FloatMap roll = OrientationCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 7,
+                                           labels, OrientationTransfer::kEpipoleRoll);
+  const FloatMap plane = OrientationCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 7,
+                                            labels, OrientationTransfer::kPlaneHomography);
+  EXPECT_GT(MaxAbsDiff(roll, plane), 0.05f);
   // Uniform-in-depth labels too.
   const DepthLabels linear(0.6, 2.0, 32, false);
-  CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources);
+  CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources,
+                      OrientationTransfer::kPlaneHomography);
   EXPECT_LT(MaxAbsDiff(volume.Compute(scene.base, 1.0f, 0, 4, linear),
                        OrientationCostCpu(scene.ref, scene.sources, scene.base, 1.0f, 0, 4,
-                                          linear)),
+                                          linear, OrientationTransfer::kPlaneHomography)),
             2e-4f);
 }
 
@@ -63,7 +73,8 @@ TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
   auto context = OpenCLContext::Create();
   const Scene scene = MakeScene(3);
   const DepthLabels labels(0.6, 2.0, 32, true);
-  CostVolumeCL volume(context.get(), StereoCost::kPhotometric, scene.ref, scene.sources, true, 2);
+  CostVolumeCL volume(context.get(), StereoCost::kPhotometric, scene.ref, scene.sources,
+                      OrientationTransfer::kNone, 2);
   const FloatMap got = volume.Compute(scene.base, 0.75f, 5, 3, labels);
   const FloatMap expected =
       PhotometricCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 3, labels, 2);

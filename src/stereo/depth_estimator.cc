@@ -281,7 +281,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         src_in.push_back({src->camera, matched(*src)});
       }
       levels[l].cost = std::make_unique<CostVolumeCL>(context, options.cost, ref_in, src_in,
-                                                      options.roll_correction,
+                                                      options.orientation_transfer,
                                                       options.ncc_window_px / 2);
       levels[l].width = ref.orientation[l].Width();
       levels[l].height = ref.orientation[l].Height();

@@ -87,6 +87,31 @@ bool FromString(const std::string& text, DepthSampling* sampling) {
   return true;
 }
 
+std::string ToString(OrientationTransfer transfer) {
+  switch (transfer) {
+    case OrientationTransfer::kNone:
+      return "off";
+    case OrientationTransfer::kEpipoleRoll:
+      return "epipole_roll";
+    case OrientationTransfer::kPlaneHomography:
+      return "plane_homography";
+  }
+  return "?";
+}
+
+bool FromString(const std::string& text, OrientationTransfer* transfer) {
+  if (text == "off") {
+    *transfer = OrientationTransfer::kNone;
+  } else if (text == "epipole_roll") {
+    *transfer = OrientationTransfer::kEpipoleRoll;
+  } else if (text == "plane_homography") {
+    *transfer = OrientationTransfer::kPlaneHomography;
+  } else {
+    return false;
+  }
+  return true;
+}
+
 std::string ToString(VisualHullBound bound) {
   switch (bound) {
     case VisualHullBound::kOff:

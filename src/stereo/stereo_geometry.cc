@@ -27,6 +27,7 @@ std::array<float, 16> ViewProjection::Packed() const {
   }
   packed[12] = static_cast<float>(std::cos(psi_rad));
   packed[13] = static_cast<float>(std::sin(psi_rad));
+  packed[14] = plane_homography ? 1.0f : 0.0f;
   return packed;
 }
 
@@ -42,7 +43,7 @@ double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_cen
 ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
                                      int ref_level_height, const StereoCamera& src,
                                      int src_level_width, int src_level_height,
-                                     bool roll_correction) {
+                                     OrientationTransfer transfer) {
   const StereoCamera r = ref.Scaled(ref_level_width, ref_level_height);
   const StereoCamera s = src.Scaled(src_level_width, src_level_height);
   // X_src = R_rel X_ref + t_rel, X_ref = D K_r^-1 x.
@@ -51,11 +52,24 @@ ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_widt
   ViewProjection projection;
   projection.H = s.K * R_rel * r.K.inverse();
   projection.b = s.K * t_rel;
-  if (roll_correction) {
+  projection.plane_homography = transfer == OrientationTransfer::kPlaneHomography;
+  if (transfer == OrientationTransfer::kEpipoleRoll) {
     projection.psi_rad =
         2.0 * (EpipoleAngle(ref, src.Center()) - EpipoleAngle(src, ref.Center()));
   }
   return projection;
+}
+
+Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth, double x,
+                                  double y, const Eigen::Vector2d& direction) {
+  // u(x, y) = D H (x, y, 1) + b; the image point is (u.x / u.z, u.y / u.z). Its Jacobian is
+  // D / u.z times rows (H_0 - p_x H_2) and (H_1 - p_y H_2) (first two columns); D / u.z > 0
+  // in front of the source.
+  const Eigen::Matrix3d& H = projection.H;
+  const Eigen::Vector3d u = depth * H * Eigen::Vector3d(x, y, 1.0) + projection.b;
+  const double px = u.x() / u.z(), py = u.y() / u.z();
+  return {(H(0, 0) - px * H(2, 0)) * direction.x() + (H(0, 1) - px * H(2, 1)) * direction.y(),
+          (H(1, 0) - py * H(2, 0)) * direction.x() + (H(1, 1) - py * H(2, 1)) * direction.y()};
 }
 
 DepthLabels::DepthLabels(double depth_min_in, double depth_max_in, int num_labels_in,

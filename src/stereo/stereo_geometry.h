@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <array>
 
+#include "hairmvs/orientation_stereo.h"
+
 namespace hairmvs {
 
 // A pinhole camera at the processing resolution: X_cam = R X_world + t.
@@ -30,14 +32,24 @@ struct ViewProjection {
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   // psi = 2 (phi_ref - phi_src): multiply O_ref* O_src by exp(i psi) (paper Eq. 5).
   double psi_rad = 0;
-  // The 16 floats the cost kernels read: H row-major, b, cos psi, sin psi, 0, 0.
+  // Map each reference orientation through the plane homography instead (psi unused).
+  bool plane_homography = false;
+  // The 16 floats the cost kernels read: H row-major, b, cos psi, sin psi, plane_homography
+  // (0 or 1), 0.
   std::array<float, 16> Packed() const;
 };
 
 ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
                                      int ref_level_height, const StereoCamera& src,
                                      int src_level_width, int src_level_height,
-                                     bool roll_correction = true);
+                                     OrientationTransfer transfer);
+
+// The direction, in the source image, of a strand that passes through the reference image
+// point (x, y) with direction (dx, dy) and lies in the fronto-parallel plane at its depth: the
+// plane's homography x -> H x (up to scale; b / D shifts it) applied to the direction, i.e. its
+// Jacobian at (x, y). Scaled by an unspecified positive factor.
+Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth, double x,
+                                  double y, const Eigen::Vector2d& direction);
 
 // Angle (radians, modulo pi is what matters) between the image +x axis and the vector from the
 // principal point of `camera` to the epipole of the camera centred at `other_center`.
