@@ -26,7 +26,7 @@ struct OrientationFieldOptions;
 
 // What is matched between views.
 enum class StereoCost {
-  kOrientation,  // paper Eq. 5: -Re(O_ref* O_v exp(2i(phi_ref - phi_v)))
+  kOrientation,  // paper Eq. 5: -Re(O'_ref* O_v), O'_ref carried as orientation_transfer says
   kPhotometric,  // baseline: -(zero-mean NCC of colour windows), same aggregation and MRF
 };
 std::string ToString(StereoCost cost);

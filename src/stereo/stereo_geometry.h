@@ -1,7 +1,8 @@
 #pragma once
 // Two-view geometry of orientation stereo: the per-view projection of a reference pixel at a
 // given depth (as a matrix and a vector, so a kernel needs no per-slice homography), the
-// epipole roll correction of paper Eq. 5, and the depth labels.
+// epipole roll correction of paper Eq. 5 and the plane-homography transfer of orientations
+// that replaces it by default, and the depth labels.
 // Pixel convention: SfM (pixel (col, row) is centred at image point (col + 0.5, row + 0.5)).
 
 #include <Eigen/Core>
