@@ -188,18 +188,19 @@ __kernel void photometric_accumulate(__global const float* ref_stats,
 }
 
 // Adds `scale` times a block of slices at (src_width, src_height), bilinearly resampled to
-// (width, height) (the same image extent; SfM pixel centres), into slices
-// [slice_offset, slice_offset + num_slices) of `volume` [slice][row][col].
+// (width, height), into slices [slice_offset, slice_offset + num_slices) of `volume`
+// [slice][row][col]. A pixel of the output is src_pixels_per_pixel source pixels wide and both
+// grids start at the image origin (pyramid levels; SfM pixel centres).
 // Global (width, height, num_slices).
 __kernel void resample_accumulate(__global const float* src, int src_width, int src_height,
                                   __global float* volume, int width, int height,
-                                  int slice_offset, float scale) {
+                                  int slice_offset, float scale, float src_pixels_per_pixel) {
   const int col = get_global_id(0);
   const int row = get_global_id(1);
   const int k = get_global_id(2);
   if (col >= width || row >= height) return;
-  const float sx = ((float)col + 0.5f) * (float)src_width / (float)width - 0.5f;
-  const float sy = ((float)row + 0.5f) * (float)src_height / (float)height - 0.5f;
+  const float sx = ((float)col + 0.5f) * src_pixels_per_pixel - 0.5f;
+  const float sy = ((float)row + 0.5f) * src_pixels_per_pixel - 0.5f;
   const float x = clamp(sx, 0.0f, (float)(src_width - 1));
   const float y = clamp(sy, 0.0f, (float)(src_height - 1));
   const float value =

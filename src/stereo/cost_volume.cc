@@ -314,7 +314,7 @@ ResampleAccumulateCL::ResampleAccumulateCL(OpenCLContext* context)
 
 void ResampleAccumulateCL::Run(const cl::Buffer& src, int src_width, int src_height,
                                int num_slices, const cl::Buffer& volume, int width, int height,
-                               int slice_offset, float scale) {
+                               int slice_offset, float scale, float src_pixels_per_pixel) {
   int a = 0;
   kernel_.setArg(a++, src);
   kernel_.setArg(a++, src_width);
@@ -324,18 +324,20 @@ void ResampleAccumulateCL::Run(const cl::Buffer& src, int src_width, int src_hei
   kernel_.setArg(a++, height);
   kernel_.setArg(a++, slice_offset);
   kernel_.setArg(a++, scale);
+  kernel_.setArg(a++, src_pixels_per_pixel);
   context_->Queue().enqueueNDRangeKernel(kernel_, cl::NullRange,
                                          cl::NDRange(width, height, num_slices));
 }
 
-FloatMap ResampleBilinear(const FloatMap& input, int width, int height) {
+FloatMap ResampleBilinear(const FloatMap& input, int width, int height,
+                          double src_pixels_per_pixel) {
   FloatMap out(width, height, input.Channels());
   const int sw = input.Width(), sh = input.Height();
   for (int c = 0; c < input.Channels(); ++c) {
     for (int row = 0; row < height; ++row) {
       for (int col = 0; col < width; ++col) {
-        const double x = std::clamp((col + 0.5) * sw / width - 0.5, 0.0, sw - 1.0);
-        const double y = std::clamp((row + 0.5) * sh / height - 0.5, 0.0, sh - 1.0);
+        const double x = std::clamp((col + 0.5) * src_pixels_per_pixel - 0.5, 0.0, sw - 1.0);
+        const double y = std::clamp((row + 0.5) * src_pixels_per_pixel - 0.5, 0.0, sh - 1.0);
         double value = 0;
         SampleBilinear(input, c, x, y, &value);
         out.At(row, col, c) = static_cast<float>(value);

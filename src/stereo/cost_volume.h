@@ -81,20 +81,25 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
                             int ncc_radius);
 
 // Adds `scale` times `num_slices` planes of (src_width, src_height), bilinearly resampled to the
-// (width, height) grid covering the same image, into slices [slice_offset, ...) of `volume`.
+// (width, height) grid, into slices [slice_offset, ...) of `volume`. Both grids are pyramid
+// levels: they start at the image origin and an output pixel is src_pixels_per_pixel source
+// pixels wide (2^(output level - source level)).
 class ResampleAccumulateCL {
  public:
   explicit ResampleAccumulateCL(OpenCLContext* context);
   void Run(const cl::Buffer& src, int src_width, int src_height, int num_slices,
-           const cl::Buffer& volume, int width, int height, int slice_offset, float scale);
+           const cl::Buffer& volume, int width, int height, int slice_offset, float scale,
+           float src_pixels_per_pixel);
 
  private:
   OpenCLContext* context_;
   cl::Kernel kernel_;
 };
 
-// Bilinear resampling of every channel to width x height (same image extent, SfM centres,
+// Bilinear resampling of every channel to width x height, an output pixel being
+// src_pixels_per_pixel input pixels wide from the same origin (pyramid levels; SfM centres,
 // clamped at the border): the CPU twin of resample_accumulate.
-FloatMap ResampleBilinear(const FloatMap& input, int width, int height);
+FloatMap ResampleBilinear(const FloatMap& input, int width, int height,
+                          double src_pixels_per_pixel);
 
 }  // namespace hairmvs

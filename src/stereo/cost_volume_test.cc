@@ -81,27 +81,49 @@ TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
   EXPECT_LT(MaxAbsDiff(got, expected), 2e-3f);
 }
 
+// Between pyramid levels: level 1 (13 x 9) up to level 0 (25 x 18), an output pixel half a
+// source pixel wide, and level 0 down to level 2 (7 x 5), four source pixels wide.
 TEST(CostVolume, ResampleAccumulateMatchesBilinearResampling) {
   auto context = OpenCLContext::Create();
-  const FloatMap src = RandomMap(13, 9, 3, 4);
-  const FloatMap expected = ResampleBilinear(src, 25, 18);
   ResampleAccumulateCL resample(context.get());
-  std::vector<float> volume(25 * 18 * 5, 1.0f);
-  cl::Buffer src_buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                        sizeof(float) * src.Data().size(), const_cast<float*>(src.Data().data()));
-  cl::Buffer volume_buffer(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
-                           sizeof(float) * volume.size(), volume.data());
-  resample.Run(src_buffer, 13, 9, 3, volume_buffer, 25, 18, 1, 2.0f);
-  context->Queue().enqueueReadBuffer(volume_buffer, CL_TRUE, 0, sizeof(float) * volume.size(),
-                                     volume.data());
-  const size_t plane = 25 * 18;
-  for (size_t i = 0; i < plane; ++i) {
-    EXPECT_FLOAT_EQ(volume[i], 1.0f);
-    EXPECT_FLOAT_EQ(volume[4 * plane + i], 1.0f);
-    for (int k = 0; k < 3; ++k) {
-      EXPECT_NEAR(volume[(k + 1) * plane + i], 1.0f + 2.0f * expected.Data()[k * plane + i], 1e-5);
+  struct Case {
+    int src_width, src_height, width, height;
+    float src_pixels_per_pixel;
+  };
+  for (const Case& c : {Case{13, 9, 25, 18, 0.5f}, Case{25, 18, 7, 5, 4.0f}}) {
+    const FloatMap src = RandomMap(c.src_width, c.src_height, 3, 4);
+    const FloatMap expected = ResampleBilinear(src, c.width, c.height, c.src_pixels_per_pixel);
+    const size_t plane = static_cast<size_t>(c.width) * c.height;
+    std::vector<float> volume(plane * 5, 1.0f);
+    cl::Buffer src_buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                          sizeof(float) * src.Data().size(),
+                          const_cast<float*>(src.Data().data()));
+    cl::Buffer volume_buffer(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                             sizeof(float) * volume.size(), volume.data());
+    resample.Run(src_buffer, c.src_width, c.src_height, 3, volume_buffer, c.width, c.height, 1,
+                 2.0f, c.src_pixels_per_pixel);
+    context->Queue().enqueueReadBuffer(volume_buffer, CL_TRUE, 0, sizeof(float) * volume.size(),
+                                       volume.data());
+    for (size_t i = 0; i < plane; ++i) {
+      EXPECT_FLOAT_EQ(volume[i], 1.0f);
+      EXPECT_FLOAT_EQ(volume[4 * plane + i], 1.0f);
+      for (int k = 0; k < 3; ++k) {
+        EXPECT_NEAR(volume[(k + 1) * plane + i], 1.0f + 2.0f * expected.Data()[k * plane + i],
+                    1e-5);
+      }
     }
   }
+}
+
+// The CPU twin on a ramp: level 1's pixel i holds i; level 0's pixel c lies at level-1
+// coordinate (c + 0.5) / 2 - 0.5 (clamped), whatever the sizes' ratio (13 is not 25 / 2).
+TEST(CostVolume, ResampleBilinearFollowsThePyramidsGrid) {
+  FloatMap ramp(13, 1, 1);
+  for (int i = 0; i < 13; ++i) ramp.At(0, i, 0) = static_cast<float>(i);
+  const FloatMap up = ResampleBilinear(ramp, 25, 1, 0.5);
+  EXPECT_FLOAT_EQ(up.At(0, 0, 0), 0.0f);   // -0.25, clamped
+  EXPECT_FLOAT_EQ(up.At(0, 3, 0), 1.25f);
+  EXPECT_FLOAT_EQ(up.At(0, 24, 0), 11.75f);
 }
 
 }  // namespace

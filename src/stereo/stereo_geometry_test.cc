@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <cmath>
 
+#include "src/orientation/orientation_field.h"
 #include "src/stereo/stereo_test_util.h"
 
 namespace hairmvs {
@@ -99,6 +100,40 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
   }
   // The roll alone misses here (1 - cos of the doubled angle error > 0.01: > 3 degrees).
   EXPECT_GT(worst_roll_error, 0.01);
+}
+
+// An odd-sized image: a bright pixel goes through the box pyramid (DownsampleGray, as the
+// orientation fields' levels are made) and lands where PyramidLevel projects its point, which
+// the size ratio (Scaled) misses by a pixel at level 2.
+TEST(StereoGeometry, PyramidLevelCamerasFollowTheBoxPyramid) {
+  const StereoCamera camera = LookAtCamera({0, 0, 0}, {0, 0, 1}, 40, 33, 21);
+  const Eigen::Vector2d bright(30.5, 19.5);  // pixel (30, 19)
+  const Eigen::Vector3d point =
+      camera.R.transpose() * (camera.K.inverse() * Eigen::Vector3d(bright.x(), bright.y(), 1.0) -
+                              camera.t);
+  FloatMap image(33, 21, 1, 0.0f);
+  image.At(19, 30, 0) = 1.0f;
+  FloatMap level = image;
+  for (int l = 1; l <= 2; ++l) {
+    level = DownsampleGray(level);
+    const StereoCamera level_camera = camera.PyramidLevel(l);
+    EXPECT_EQ(level_camera.width, level.Width());
+    EXPECT_EQ(level_camera.height, level.Height());
+    int best_col = 0, best_row = 0;
+    for (int row = 0; row < level.Height(); ++row) {
+      for (int col = 0; col < level.Width(); ++col) {
+        if (level.At(row, col, 0) > level.At(best_row, best_col, 0)) best_col = col, best_row = row;
+      }
+    }
+    const Eigen::Vector2d projected =
+        (level_camera.K * (level_camera.R * point + level_camera.t)).hnormalized();
+    EXPECT_EQ(static_cast<int>(std::floor(projected.x())), best_col) << "level " << l;
+    EXPECT_EQ(static_cast<int>(std::floor(projected.y())), best_row) << "level " << l;
+  }
+  const StereoCamera by_ratio = camera.Scaled(9, 6);  // level 2's size, the extent kept
+  const Eigen::Vector2d off = (by_ratio.K * (by_ratio.R * point + by_ratio.t)).hnormalized();
+  EXPECT_EQ(static_cast<int>(std::floor(off.x())), 8);
+  EXPECT_EQ(static_cast<int>(std::floor(off.y())), 5);
 }
 
 }  // namespace
