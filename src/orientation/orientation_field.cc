@@ -25,17 +25,17 @@ void CheckInputs(const FloatMap& gray, const FloatMap& mask) {
 
 }  // namespace
 
-FloatMap DownsampleGray(const FloatMap& gray) {
-  const int w = (gray.Width() + 1) / 2, h = (gray.Height() + 1) / 2;
-  FloatMap out(w, h, gray.Channels());
-  for (int c = 0; c < gray.Channels(); ++c) {
+FloatMap DownsampleHalf(const FloatMap& image) {
+  const int w = (image.Width() + 1) / 2, h = (image.Height() + 1) / 2;
+  FloatMap out(w, h, image.Channels());
+  for (int c = 0; c < image.Channels(); ++c) {
     for (int row = 0; row < h; ++row) {
       for (int col = 0; col < w; ++col) {
         float sum = 0;
         int count = 0;
-        for (int r = 2 * row; r < std::min(2 * row + 2, gray.Height()); ++r) {
-          for (int q = 2 * col; q < std::min(2 * col + 2, gray.Width()); ++q) {
-            sum += gray.At(r, q, c);
+        for (int r = 2 * row; r < std::min(2 * row + 2, image.Height()); ++r) {
+          for (int q = 2 * col; q < std::min(2 * col + 2, image.Width()); ++q) {
+            sum += image.At(r, q, c);
             ++count;
           }
         }
@@ -54,7 +54,7 @@ FloatMap DownsampleMask(const FloatMap& mask) {
       binary.At(row, col) = mask.At(row, col) > 0 ? 1.0f : 0.0f;
     }
   }
-  FloatMap out = DownsampleGray(binary);
+  FloatMap out = DownsampleHalf(binary);
   for (float& v : out.Data()) v = v >= 0.5f ? 1.0f : 0.0f;
   return out;
 }
@@ -105,7 +105,7 @@ std::vector<FloatMap> ComputeOrientationFieldReference(const FloatMap& gray, con
   FloatMap level_gray = gray, level_mask = mask;
   for (int l = 0; l < options.num_levels; ++l) {
     if (l > 0) {
-      level_gray = DownsampleGray(level_gray);
+      level_gray = DownsampleHalf(level_gray);
       level_mask = DownsampleMask(level_mask);
     }
     levels.push_back(
@@ -163,7 +163,7 @@ std::vector<FloatMap> OrientationFieldComputer::Compute(const FloatMap& gray, co
   for (int l = 0; l < options_.num_levels; ++l) {
     if (l > 0) {
       ScopedStageTimer timer(timings_, "downsample");
-      level_gray = DownsampleGray(l == 1 ? gray : level_gray);
+      level_gray = DownsampleHalf(l == 1 ? gray : level_gray);
       level_mask = DownsampleMask(l == 1 ? mask : level_mask);
     }
     levels.push_back(ComputeLevel(l == 0 ? gray : level_gray, l == 0 ? mask : level_mask));

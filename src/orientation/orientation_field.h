@@ -9,7 +9,7 @@
 //           strand; r = min_positive_response_ratio, the paper's 0 up to rounding) and the
 //           pixel is not masked, else 0.
 // Theta is measured from image +x towards +y (clockwise on screen), modulo pi.
-// Levels: level 0 = the input; level k+1 = DownsampleGray(level k), of size
+// Levels: level 0 = the input; level k+1 = DownsampleHalf(level k), of size
 // ((W_k + 1) / 2, (H_k + 1) / 2); the same fixed-size filters at every level.
 
 #include <memory>
@@ -24,9 +24,10 @@ namespace hairmvs {
 
 class OpenCLContext;
 
-// 2x2 box average to ((W + 1) / 2, (H + 1) / 2); at an odd last row/column the average of
-// the pixels that exist.
-FloatMap DownsampleGray(const FloatMap& gray);
+// 2x2 box average of every channel to ((W + 1) / 2, (H + 1) / 2); at an odd last row/column the
+// average of the pixels that exist. The pyramid of the orientation fields and of the
+// photometric cost's colour images (StereoCamera::PyramidLevel is its camera).
+FloatMap DownsampleHalf(const FloatMap& image);
 // The mask of the next level: 1 where the average of the covered mask pixels is >= 0.5
 // (a mask pixel counts as valid when > 0), else 0. An empty mask stays empty (= all valid).
 FloatMap DownsampleMask(const FloatMap& mask);

@@ -169,7 +169,7 @@ TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
   std::vector<Reference> references(3);
   for (int l = 0; l < 3; ++l) {
     Reference& ref = references[l];
-    ref.gray = l == 0 ? gray : DownsampleGray(references[l - 1].gray);
+    ref.gray = l == 0 ? gray : DownsampleHalf(references[l - 1].gray);
     ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
     ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank, options.confidence_gamma,
                                                  options.min_positive_response_ratio,
@@ -196,7 +196,7 @@ TEST_F(OrientationFieldTest, LevelSizesAndDownsampling) {
   for (int row = 0; row < 5; ++row) {
     for (int col = 0; col < 7; ++col) gray.At(row, col) = static_cast<float>(row * 7 + col);
   }
-  const FloatMap half = DownsampleGray(gray);
+  const FloatMap half = DownsampleHalf(gray);
   ASSERT_EQ(half.Width(), 4);
   ASSERT_EQ(half.Height(), 3);
   EXPECT_FLOAT_EQ(half.At(0, 0), (0 + 1 + 7 + 8) / 4.0f);

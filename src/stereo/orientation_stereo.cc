@@ -214,26 +214,6 @@ FloatMap ResizeArea(const FloatMap& input, int width, int height) {
   return out;
 }
 
-FloatMap DownsampleRgb(const FloatMap& rgb) {
-  FloatMap out((rgb.Width() + 1) / 2, (rgb.Height() + 1) / 2, 3);
-  for (int c = 0; c < 3; ++c) {
-    for (int row = 0; row < out.Height(); ++row) {
-      for (int col = 0; col < out.Width(); ++col) {
-        double sum = 0;
-        int count = 0;
-        for (int r = 2 * row; r < std::min(2 * row + 2, rgb.Height()); ++r) {
-          for (int q = 2 * col; q < std::min(2 * col + 2, rgb.Width()); ++q) {
-            sum += rgb.At(r, q, c);
-            ++count;
-          }
-        }
-        out.At(row, col, c) = static_cast<float>(sum / count);
-      }
-    }
-  }
-  return out;
-}
-
 void WriteDepthPng(const std::string& path, const FloatMap& depth) {
   std::vector<float> valid;
   for (float d : depth.Data()) {
@@ -358,9 +338,10 @@ class ViewLoader {
     const int w = data.camera.width, h = data.camera.height;
 
     // Expected level sizes.
-    std::vector<std::array<int, 2>> sizes = {{w, h}};
-    for (int l = 1; l < options_.num_levels; ++l) {
-      sizes.push_back({(sizes.back()[0] + 1) / 2, (sizes.back()[1] + 1) / 2});
+    std::vector<std::array<int, 2>> sizes;
+    for (int l = 0; l < options_.num_levels; ++l) {
+      const StereoCamera level = data.camera.PyramidLevel(l);
+      sizes.push_back({level.width, level.height});
     }
     bool reused = options_.reuse_orientation_maps;
     for (int l = 0; l < options_.num_levels && reused; ++l) {
@@ -404,7 +385,7 @@ class ViewLoader {
     }
     if (options_.cost == StereoCost::kPhotometric) {
       data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
-      for (int l = 1; l < options_.num_levels; ++l) data.rgb.push_back(DownsampleRgb(data.rgb.back()));
+      for (int l = 1; l < options_.num_levels; ++l) data.rgb.push_back(DownsampleHalf(data.rgb.back()));
     }
     return data;
   }

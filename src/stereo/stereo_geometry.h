@@ -23,7 +23,7 @@ struct StereoCamera {
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // The same camera for an image of width x height covering the same extent (a resized image).
   StereoCamera Scaled(int new_width, int new_height) const;
-  // The camera of level `level` of the 2 x 2 box pyramid (DownsampleGray in
+  // The camera of level `level` of the 2 x 2 box pyramid (DownsampleHalf in
   // src/orientation/orientation_field.h): image coordinates halve exactly at every level and the
   // size is ceil(size / 2^level). Not Scaled(ceil(W / 2^level), ...): for an odd size the last
   // pixel of a level reaches beyond the image, so the level does not cover the same extent.

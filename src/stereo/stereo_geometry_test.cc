@@ -102,7 +102,7 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
   EXPECT_GT(worst_roll_error, 0.01);
 }
 
-// An odd-sized image: a bright pixel goes through the box pyramid (DownsampleGray, as the
+// An odd-sized image: a bright pixel goes through the box pyramid (DownsampleHalf, as the
 // orientation fields' levels are made) and lands where PyramidLevel projects its point, which
 // the size ratio (Scaled) misses by a pixel at level 2.
 TEST(StereoGeometry, PyramidLevelCamerasFollowTheBoxPyramid) {
@@ -115,7 +115,7 @@ TEST(StereoGeometry, PyramidLevelCamerasFollowTheBoxPyramid) {
   image.At(19, 30, 0) = 1.0f;
   FloatMap level = image;
   for (int l = 1; l <= 2; ++l) {
-    level = DownsampleGray(level);
+    level = DownsampleHalf(level);
     const StereoCamera level_camera = camera.PyramidLevel(l);
     EXPECT_EQ(level_camera.width, level.Width());
     EXPECT_EQ(level_camera.height, level.Height());
