@@ -37,8 +37,8 @@ bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double
 // coordinates: pixel centres at integers), through the world frame. False behind the camera.
 bool ProjectCpu(const CostViewInput& ref, const CostViewInput& src, double x_ref, double y_ref,
                 double depth, double* x, double* y) {
-  const StereoCamera r = ref.camera.Scaled(ref.field.Width(), ref.field.Height());
-  const StereoCamera s = src.camera.Scaled(src.field.Width(), src.field.Height());
+  const StereoCamera& r = ref.camera;
+  const StereoCamera& s = src.camera;
   const Eigen::Vector3d ray = r.K.inverse() * Eigen::Vector3d(x_ref, y_ref, 1.0);
   const Eigen::Vector3d world = r.R.transpose() * (depth * ray - r.t);
   const Eigen::Vector3d u = s.K * (s.R * world + s.t);
@@ -57,15 +57,17 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
       num_views_(static_cast<int>(sources.size())), ncc_radius_(ncc_radius) {
   const int expected_channels = cost == StereoCost::kOrientation ? 2 : 3;
   CHECK_EQ(ref.field.Channels(), expected_channels);
+  CHECK_EQ(ref.camera.width, width_);
+  CHECK_EQ(ref.camera.height, height_);
   ref_ = Upload(context, ref.field.Data().data(), sizeof(float) * ref.field.Data().size());
   std::vector<float> params;
   std::vector<int> dims;
   std::vector<float> all_sources;
   for (const CostViewInput& src : sources) {
     CHECK_EQ(src.field.Channels(), expected_channels);
-    const ViewProjection projection =
-        ComputeViewProjection(ref.camera, width_, height_, src.camera, src.field.Width(),
-                              src.field.Height(), transfer);
+    CHECK_EQ(src.camera.width, src.field.Width());
+    CHECK_EQ(src.camera.height, src.field.Height());
+    const ViewProjection projection = ComputeViewProjection(ref.camera, src.camera, transfer);
     const auto packed = projection.Packed();
     params.insert(params.end(), packed.begin(), packed.end());
     dims.insert(dims.end(), {src.field.Width(), src.field.Height(),

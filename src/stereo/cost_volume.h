@@ -21,8 +21,8 @@ namespace hairmvs {
 
 class OpenCLContext;
 
-// A view at one level: its camera at the processing resolution (scaled to the level from the
-// field's size) and its field: orientation (2 channels) or colour (3 channels).
+// A view at one level: its camera on the field's grid (a pyramid level's:
+// StereoCamera::PyramidLevel) and its field: orientation (2 channels) or colour (3 channels).
 struct CostViewInput {
   StereoCamera camera;
   FloatMap field;

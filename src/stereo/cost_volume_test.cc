@@ -24,15 +24,16 @@ struct Scene {
   std::vector<float> base;
 };
 
-// A reference at a level of 48 x 36 (of a 96 x 72 camera) and two sources of other sizes, one
+// A reference at level 1 (48 x 36) of a 96 x 72 camera and two sources of other sizes, one
 // rolled: random fields, so every sample position and the roll factor matter.
 Scene MakeScene(int channels) {
   Scene scene;
-  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 100, 96, 72);
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 100, 96, 72).PyramidLevel(1);
   scene.ref = {ref, RandomMap(48, 36, channels, 1, channels == 3 ? 0.0f : -1.0f)};
-  scene.sources.push_back({LookAtCamera({0.25, 0, 0}, {0, 0, 1}, 100, 96, 72, 0.7),
-                           RandomMap(48, 36, channels, 2, channels == 3 ? 0.0f : -1.0f)});
-  scene.sources.push_back({LookAtCamera({0, 0.2, 0.05}, {0, 0, 1}, 90, 80, 60),
+  scene.sources.push_back(
+      {LookAtCamera({0.25, 0, 0}, {0, 0, 1}, 100, 96, 72, 0.7).PyramidLevel(1),
+       RandomMap(48, 36, channels, 2, channels == 3 ? 0.0f : -1.0f)});
+  scene.sources.push_back({LookAtCamera({0, 0.2, 0.05}, {0, 0, 1}, 90, 80, 60).PyramidLevel(1),
                            RandomMap(40, 30, channels, 3, channels == 3 ? 0.0f : -1.0f)});
   scene.base.resize(48 * 36);
   for (size_t i = 0; i < scene.base.size(); ++i) scene.base[i] = 0.37f * (i % 5);

@@ -275,15 +275,11 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         if (photometric) return view.rgb[l];
         return view.matching.empty() ? view.orientation[l] : view.matching[l];
       };
-      // Level cameras as the pyramid makes the levels (not scaled by the size ratio).
+      // Level cameras as the pyramid makes the levels (CostVolumeCL checks their sizes).
       CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref)};
-      CHECK_EQ(ref_in.camera.width, ref_in.field.Width());
-      CHECK_EQ(ref_in.camera.height, ref_in.field.Height());
       std::vector<CostViewInput> src_in;
       for (const StereoViewData* src : sources) {
         src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
-        CHECK_EQ(src_in.back().camera.width, src_in.back().field.Width());
-        CHECK_EQ(src_in.back().camera.height, src_in.back().field.Height());
       }
       levels[l].cost = std::make_unique<CostVolumeCL>(context, options.cost, ref_in, src_in,
                                                       options.orientation_transfer,
@@ -340,7 +336,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         ScopedStageTimer timer(timings, "aggregation");
         levels[l].filter->Filter(blocks[l], ns, blocks[l]);
         resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0,
-                     level_weight, static_cast<float>(std::ldexp(1.0, grid_level - l)));
+                     level_weight, static_cast<float>(LevelPixelsPerPixel(l, grid_level)));
         queue.finish();
       }
     }
@@ -405,8 +401,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   if (use_prior) {
     ScopedStageTimer timer(timings, "geometric prior");
     prior_scale = MedianCostRange(coarse_volume, static_cast<size_t>(cw) * ch, num_depths);
-    AddGeometricPrior(*prior, ref.camera.PyramidLevel(coarse_level), std::ldexp(1.0, coarse_level),
-                      labels, {}, 1.0f, num_depths, prior_scale, &coarse_volume);
+    AddGeometricPrior(*prior, ref.camera.PyramidLevel(coarse_level),
+                      LevelPixelsPerPixel(0, coarse_level), labels, {}, 1.0f, num_depths,
+                      prior_scale, &coarse_volume);
   }
   // The depth lower bound as labels on the level-0 grid (-inf = none).
   std::vector<float> bound0;
@@ -478,7 +475,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     std::vector<std::vector<float>> base(num_levels);
     for (int l = 0; l < num_levels; ++l) {
       const FloatMap up = ResampleBilinear(coarse_value, levels[l].width, levels[l].height,
-                                           std::ldexp(1.0, l - coarse_level));
+                                           LevelPixelsPerPixel(coarse_level, l));
       base[l].resize(up.Data().size());
       for (size_t p = 0; p < base[l].size(); ++p) {
         base[l][p] = std::clamp(up.Data()[p] - half, 0.0f, max_base);
@@ -513,7 +510,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   ScopedStageTimer timer(timings, "refinement");
   estimate.confidence = coarse_level == 0 ? coarse_confidence
                                           : ResampleBilinear(coarse_confidence, width0, height0,
-                                                             std::ldexp(1.0, -coarse_level));
+                                                             LevelPixelsPerPixel(coarse_level, 0));
   FloatMap depth(width0, height0, 1);
   for (size_t p = 0; p < depth.Data().size(); ++p) {
     depth.Data()[p] = static_cast<float>(labels.Depth(value.Data()[p]));

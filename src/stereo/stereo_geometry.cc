@@ -52,24 +52,24 @@ double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_cen
   return std::atan2(vy, vx);
 }
 
-ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
-                                     int ref_level_height, const StereoCamera& src,
-                                     int src_level_width, int src_level_height,
+ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera& src,
                                      OrientationTransfer transfer) {
-  const StereoCamera r = ref.Scaled(ref_level_width, ref_level_height);
-  const StereoCamera s = src.Scaled(src_level_width, src_level_height);
   // X_src = R_rel X_ref + t_rel, X_ref = D K_r^-1 x.
-  const Eigen::Matrix3d R_rel = s.R * r.R.transpose();
-  const Eigen::Vector3d t_rel = s.t - R_rel * r.t;
+  const Eigen::Matrix3d R_rel = src.R * ref.R.transpose();
+  const Eigen::Vector3d t_rel = src.t - R_rel * ref.t;
   ViewProjection projection;
-  projection.H = s.K * R_rel * r.K.inverse();
-  projection.b = s.K * t_rel;
+  projection.H = src.K * R_rel * ref.K.inverse();
+  projection.b = src.K * t_rel;
   projection.plane_homography = transfer == OrientationTransfer::kPlaneHomography;
   if (transfer == OrientationTransfer::kEpipoleRoll) {
     projection.psi_rad =
         2.0 * (EpipoleAngle(ref, src.Center()) - EpipoleAngle(src, ref.Center()));
   }
   return projection;
+}
+
+double LevelPixelsPerPixel(int level, int grid_level) {
+  return std::ldexp(1.0, grid_level - level);
 }
 
 Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth, double x,

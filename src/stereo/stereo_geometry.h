@@ -30,9 +30,8 @@ struct StereoCamera {
   StereoCamera PyramidLevel(int level) const;
 };
 
-// u = D * H * (x, y, 1) + b maps the reference image point (x, y) of a level of size
-// (ref_level_width, ref_level_height) at z-depth D to homogeneous image coordinates of the
-// source at its level of size (src_level_width, src_level_height).
+// u = D * H * (x, y, 1) + b maps the reference image point (x, y) at z-depth D to homogeneous
+// image coordinates of the source (both on the grids their cameras are for).
 struct ViewProjection {
   Eigen::Matrix3d H = Eigen::Matrix3d::Identity();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
@@ -45,10 +44,14 @@ struct ViewProjection {
   std::array<float, 16> Packed() const;
 };
 
-ViewProjection ComputeViewProjection(const StereoCamera& ref, int ref_level_width,
-                                     int ref_level_height, const StereoCamera& src,
-                                     int src_level_width, int src_level_height,
+// ref, src: the cameras of the grids the map goes between (a pyramid level's:
+// StereoCamera::PyramidLevel).
+ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera& src,
                                      OrientationTransfer transfer);
+
+// Pixels of pyramid level `level` per pixel of level `grid_level`: 2^(grid_level - level)
+// (the levels halve exactly and share the image origin).
+double LevelPixelsPerPixel(int level, int grid_level);
 
 // The direction, in the source image, of a strand that passes through the reference image
 // point (x, y) with direction (dx, dy) and lies in the fronto-parallel plane at its depth: the

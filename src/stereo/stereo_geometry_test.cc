@@ -17,11 +17,8 @@ TEST(StereoGeometry, ViewProjectionMatchesTheWorldPathAtEveryLevel) {
   const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 100, 96, 72);
   const StereoCamera src = LookAtCamera({0.3, 0.1, 0.05}, {0, 0, 1}, 110, 90, 70, 0.4);
   for (int level = 0; level < 3; ++level) {
-    const int rw = (96 + (1 << level) - 1) >> level, rh = (72 + (1 << level) - 1) >> level;
-    const int sw = (90 + (1 << level) - 1) >> level, sh = (70 + (1 << level) - 1) >> level;
-    const ViewProjection proj =
-        ComputeViewProjection(ref, rw, rh, src, sw, sh, OrientationTransfer::kEpipoleRoll);
-    const StereoCamera r = ref.Scaled(rw, rh), s = src.Scaled(sw, sh);
+    const StereoCamera r = ref.PyramidLevel(level), s = src.PyramidLevel(level);
+    const ViewProjection proj = ComputeViewProjection(r, s, OrientationTransfer::kEpipoleRoll);
     for (double depth : {0.7, 1.0, 1.6}) {
       const Eigen::Vector3d x(12.5, 30.5, 1.0);
       const Eigen::Vector3d world = r.R.transpose() * (depth * r.K.inverse() * x - r.t);
@@ -39,7 +36,7 @@ TEST(StereoGeometry, RollCorrectionCancelsARollAboutTheOpticalAxis) {
   for (double roll : {0.0, 0.5, 1.0, -1.2}) {
     const StereoCamera src = LookAtCamera({0.2, 0, 0}, {0, 0, 1}, 100, 96, 72, roll);
     const ViewProjection proj =
-        ComputeViewProjection(ref, 96, 72, src, 96, 72, OrientationTransfer::kEpipoleRoll);
+        ComputeViewProjection(ref, src, OrientationTransfer::kEpipoleRoll);
     // A short 3D segment on the plane z = 1 projected into both views.
     const Eigen::Vector3d a(0.0, 0.0, 1.0), b(0.02, 0.01, 1.0);
     auto angle = [](const StereoCamera& c, const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
@@ -74,7 +71,7 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
   const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 100, 96, 72);
   const StereoCamera src = LookAtCamera({0.45, -0.35, 0.15}, {0, 0, 1}, 120, 96, 72, 0.3);
   const ViewProjection proj =
-      ComputeViewProjection(ref, 96, 72, src, 96, 72, OrientationTransfer::kPlaneHomography);
+      ComputeViewProjection(ref, src, OrientationTransfer::kPlaneHomography);
   EXPECT_TRUE(proj.plane_homography);
   EXPECT_EQ(proj.Packed()[14], 1.0f);
   auto image_point = [](const StereoCamera& c, const Eigen::Vector3d& p) {
@@ -94,7 +91,7 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
     const double theta_ref = std::atan2(in_ref.y(), in_ref.x());
     const double theta_src = std::atan2(in_src.y(), in_src.x());
     const ViewProjection roll =
-        ComputeViewProjection(ref, 96, 72, src, 96, 72, OrientationTransfer::kEpipoleRoll);
+        ComputeViewProjection(ref, src, OrientationTransfer::kEpipoleRoll);
     worst_roll_error = std::max(
         worst_roll_error, 1.0 - std::cos(2 * (theta_src - theta_ref) + roll.psi_rad));
   }
