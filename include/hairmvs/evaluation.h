@@ -91,7 +91,8 @@ struct DepthEvaluationOptions {
   void ForEachField(Visitor&& v) {
     v("depth_type", &depth_type, "geometric or photometric");
     v("image_names", &image_names, "views to evaluate (comma-separated; empty = all)");
-    v("output_path", &output_path, "folder for error pictures and JSON (default W/stereo/evaluation)");
+    v("output_path", &output_path,
+      "folder for error pictures and JSON (default W/stereo/evaluation)");
     v("write_error_images", &write_error_images,
       "write <name>.error.png and <name>.signed_error.png per view");
     v("error_image_max_mm", &error_image_max_mm, "error at the red end of the colour scale (mm)");

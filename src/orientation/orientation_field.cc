@@ -156,7 +156,8 @@ OrientationFieldComputer::OrientationFieldComputer(std::shared_ptr<OpenCLContext
 
 OrientationFieldComputer::~OrientationFieldComputer() = default;
 
-std::vector<FloatMap> OrientationFieldComputer::Compute(const FloatMap& gray, const FloatMap& mask) {
+std::vector<FloatMap> OrientationFieldComputer::Compute(const FloatMap& gray,
+                                                       const FloatMap& mask) {
   CheckInputs(gray, mask);
   std::vector<FloatMap> levels;
   FloatMap level_gray, level_mask;

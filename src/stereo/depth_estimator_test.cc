@@ -68,8 +68,8 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
   auto context = OpenCLContext::Create();
   const DepthLabels labels(depth_min, depth_max, options.num_depths, true);
-  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(), FloatMap(),
-                                                  labels, options, nullptr);
+  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
+                                                  FloatMap(), labels, options, nullptr);
   std::vector<double> errors;
   int truth = 0;
   for (size_t p = 0; p < true_depth.Data().size(); ++p) {

@@ -385,7 +385,9 @@ class ViewLoader {
     }
     if (options_.cost == StereoCost::kPhotometric) {
       data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
-      for (int l = 1; l < options_.num_levels; ++l) data.rgb.push_back(DownsampleHalf(data.rgb.back()));
+      for (int l = 1; l < options_.num_levels; ++l) {
+        data.rgb.push_back(DownsampleHalf(data.rgb.back()));
+      }
     }
     return data;
   }

@@ -86,7 +86,8 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
     const Eigen::Vector2d x = image_point(ref, a);
     const Eigen::Vector2d got = TransferDirection(proj, 1.0, x.x(), x.y(), in_ref.normalized());
     // The same line: the directions agree up to sign and a positive scale.
-    const double sine = (got.x() * in_src.y() - got.y() * in_src.x()) / (got.norm() * in_src.norm());
+    const double sine =
+        (got.x() * in_src.y() - got.y() * in_src.x()) / (got.norm() * in_src.norm());
     EXPECT_NEAR(sine, 0.0, 1e-3) << "angle " << angle;
     const double theta_ref = std::atan2(in_ref.y(), in_ref.x());
     const double theta_src = std::atan2(in_src.y(), in_src.x());
