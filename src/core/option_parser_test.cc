@@ -2,18 +2,29 @@
 
 #include <gtest/gtest.h>
 
+#include "src/core/enum_names.h"
 #include "src/core/logging.h"
 
 namespace hairmvs {
 namespace {
 
 enum class Solver { kGraphCuts, kSemiGlobal };
-std::string ToString(Solver s) { return s == Solver::kGraphCuts ? "graph_cuts" : "semi_global"; }
+constexpr std::pair<Solver, const char*> kSolverNames[] = {{Solver::kGraphCuts, "graph_cuts"},
+                                                           {Solver::kSemiGlobal, "semi_global"}};
+std::string ToString(Solver s) { return EnumName(kSolverNames, s); }
 bool FromString(const std::string& text, Solver* s) {
-  if (text == "graph_cuts") *s = Solver::kGraphCuts;
-  else if (text == "semi_global") *s = Solver::kSemiGlobal;
-  else return false;
-  return true;
+  return EnumFromName(kSolverNames, text, s);
+}
+
+// Both directions come from the one table; an unknown name is refused and leaves the value.
+TEST(EnumNames, NamesAndValuesFromOneTable) {
+  EXPECT_EQ(ToString(Solver::kSemiGlobal), "semi_global");
+  EXPECT_EQ(ToString(Solver::kGraphCuts), "graph_cuts");
+  Solver solver = Solver::kGraphCuts;
+  EXPECT_TRUE(FromString("semi_global", &solver));
+  EXPECT_EQ(solver, Solver::kSemiGlobal);
+  EXPECT_FALSE(FromString("semi-global", &solver));
+  EXPECT_EQ(solver, Solver::kSemiGlobal);
 }
 
 struct ToyOptions {

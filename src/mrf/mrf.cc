@@ -6,6 +6,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "src/core/enum_names.h"
 #include "src/core/logging.h"
 #include "src/core/timer.h"
 #include "src/mrf/belief_propagation.h"
@@ -159,30 +160,23 @@ int PolishWithIcm(const MrfProblem& problem, int max_iterations, std::vector<int
   return sweeps;
 }
 
-std::string ToString(MrfSolverType type) {
-  switch (type) {
-    case MrfSolverType::kGraphCuts: return "graph_cuts";
-    case MrfSolverType::kSemiGlobal: return "semi_global";
-    case MrfSolverType::kSemiGlobalCpu: return "semi_global_cpu";
-    case MrfSolverType::kBeliefPropagation: return "belief_propagation";
-    case MrfSolverType::kBeliefPropagationCpu: return "belief_propagation_cpu";
-    case MrfSolverType::kIcm: return "icm";
-    case MrfSolverType::kWinnerTakeAll: return "winner_take_all";
-  }
-  return "unknown";
-}
+namespace {
+
+constexpr std::pair<MrfSolverType, const char*> kMrfSolverNames[] = {
+    {MrfSolverType::kGraphCuts, "graph_cuts"},
+    {MrfSolverType::kSemiGlobal, "semi_global"},
+    {MrfSolverType::kSemiGlobalCpu, "semi_global_cpu"},
+    {MrfSolverType::kBeliefPropagation, "belief_propagation"},
+    {MrfSolverType::kBeliefPropagationCpu, "belief_propagation_cpu"},
+    {MrfSolverType::kIcm, "icm"},
+    {MrfSolverType::kWinnerTakeAll, "winner_take_all"}};
+
+}  // namespace
+
+std::string ToString(MrfSolverType type) { return EnumName(kMrfSolverNames, type); }
 
 bool FromString(const std::string& text, MrfSolverType* type) {
-  for (MrfSolverType t : {MrfSolverType::kGraphCuts, MrfSolverType::kSemiGlobal,
-                          MrfSolverType::kSemiGlobalCpu, MrfSolverType::kBeliefPropagation,
-                          MrfSolverType::kBeliefPropagationCpu, MrfSolverType::kIcm,
-                          MrfSolverType::kWinnerTakeAll}) {
-    if (text == ToString(t)) {
-      *type = t;
-      return true;
-    }
-  }
-  return false;
+  return EnumFromName(kMrfSolverNames, text, type);
 }
 
 bool UsesOpenCL(MrfSolverType type) {

@@ -20,6 +20,7 @@
 #include "colmap_ext/workspace.h"
 #include "hairmvs/orientation_fields.h"
 #include "src/core/depth_geometry.h"
+#include "src/core/enum_names.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
@@ -59,82 +60,40 @@ struct FirstEstimate {
 
 }  // namespace
 
-std::string ToString(StereoCost cost) {
-  return cost == StereoCost::kOrientation ? "orientation" : "photometric";
-}
+namespace {
+
+constexpr std::pair<StereoCost, const char*> kStereoCostNames[] = {
+    {StereoCost::kOrientation, "orientation"}, {StereoCost::kPhotometric, "photometric"}};
+constexpr std::pair<DepthSampling, const char*> kDepthSamplingNames[] = {
+    {DepthSampling::kDepth, "depth"}, {DepthSampling::kInverseDepth, "inverse_depth"}};
+constexpr std::pair<OrientationTransfer, const char*> kOrientationTransferNames[] = {
+    {OrientationTransfer::kNone, "off"},
+    {OrientationTransfer::kEpipoleRoll, "epipole_roll"},
+    {OrientationTransfer::kPlaneHomography, "plane_homography"}};
+constexpr std::pair<VisualHullBound, const char*> kVisualHullBoundNames[] = {
+    {VisualHullBound::kOff, "off"},
+    {VisualHullBound::kPenalty, "penalty"},
+    {VisualHullBound::kFilter, "filter"}};
+
+}  // namespace
+
+std::string ToString(StereoCost cost) { return EnumName(kStereoCostNames, cost); }
 bool FromString(const std::string& text, StereoCost* cost) {
-  if (text == "orientation") {
-    *cost = StereoCost::kOrientation;
-  } else if (text == "photometric") {
-    *cost = StereoCost::kPhotometric;
-  } else {
-    return false;
-  }
-  return true;
+  return EnumFromName(kStereoCostNames, text, cost);
 }
-
-std::string ToString(DepthSampling sampling) {
-  return sampling == DepthSampling::kDepth ? "depth" : "inverse_depth";
-}
+std::string ToString(DepthSampling sampling) { return EnumName(kDepthSamplingNames, sampling); }
 bool FromString(const std::string& text, DepthSampling* sampling) {
-  if (text == "depth") {
-    *sampling = DepthSampling::kDepth;
-  } else if (text == "inverse_depth") {
-    *sampling = DepthSampling::kInverseDepth;
-  } else {
-    return false;
-  }
-  return true;
+  return EnumFromName(kDepthSamplingNames, text, sampling);
 }
-
 std::string ToString(OrientationTransfer transfer) {
-  switch (transfer) {
-    case OrientationTransfer::kNone:
-      return "off";
-    case OrientationTransfer::kEpipoleRoll:
-      return "epipole_roll";
-    case OrientationTransfer::kPlaneHomography:
-      return "plane_homography";
-  }
-  return "?";
+  return EnumName(kOrientationTransferNames, transfer);
 }
-
 bool FromString(const std::string& text, OrientationTransfer* transfer) {
-  if (text == "off") {
-    *transfer = OrientationTransfer::kNone;
-  } else if (text == "epipole_roll") {
-    *transfer = OrientationTransfer::kEpipoleRoll;
-  } else if (text == "plane_homography") {
-    *transfer = OrientationTransfer::kPlaneHomography;
-  } else {
-    return false;
-  }
-  return true;
+  return EnumFromName(kOrientationTransferNames, text, transfer);
 }
-
-std::string ToString(VisualHullBound bound) {
-  switch (bound) {
-    case VisualHullBound::kOff:
-      return "off";
-    case VisualHullBound::kPenalty:
-      return "penalty";
-    case VisualHullBound::kFilter:
-      return "filter";
-  }
-  return "?";
-}
-
+std::string ToString(VisualHullBound bound) { return EnumName(kVisualHullBoundNames, bound); }
 bool FromString(const std::string& text, VisualHullBound* bound) {
-  if (text == "off") {
-    *bound = VisualHullBound::kOff;
-  } else if (text == "penalty") {
-    *bound = VisualHullBound::kPenalty;
-  } else if (text == "filter") {
-    *bound = VisualHullBound::kFilter;
-  } else {
-    return false;
-  }
-  return true;
+  return EnumFromName(kVisualHullBoundNames, text, bound);
 }
 
 int OrientationStereoOptions::WindowPx(int level) const {

@@ -11,6 +11,7 @@
 
 #include "colmap_ext/reconstruction.h"
 #include "src/core/depth_geometry.h"
+#include "src/core/enum_names.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
@@ -88,23 +89,22 @@ cv::Mat LabelPicture(const std::vector<uint8_t>& label, int width, int height) {
 
 }  // namespace
 
-std::string ToString(HairStyle style) {
-  return style == HairStyle::kCurly ? "curly" : "straight";
-}
+namespace {
+
+constexpr std::pair<HairStyle, const char*> kHairStyleNames[] = {
+    {HairStyle::kStraight, "straight"}, {HairStyle::kCurly, "curly"}};
+constexpr std::pair<CameraRigType, const char*> kCameraRigNames[] = {
+    {CameraRigType::kGantry, "gantry"}, {CameraRigType::kHandheld, "handheld"}};
+
+}  // namespace
+
+std::string ToString(HairStyle style) { return EnumName(kHairStyleNames, style); }
 bool FromString(const std::string& text, HairStyle* style) {
-  if (text == "straight") *style = HairStyle::kStraight;
-  else if (text == "curly") *style = HairStyle::kCurly;
-  else return false;
-  return true;
+  return EnumFromName(kHairStyleNames, text, style);
 }
-std::string ToString(CameraRigType rig) {
-  return rig == CameraRigType::kHandheld ? "handheld" : "gantry";
-}
+std::string ToString(CameraRigType rig) { return EnumName(kCameraRigNames, rig); }
 bool FromString(const std::string& text, CameraRigType* rig) {
-  if (text == "gantry") *rig = CameraRigType::kGantry;
-  else if (text == "handheld") *rig = CameraRigType::kHandheld;
-  else return false;
-  return true;
+  return EnumFromName(kCameraRigNames, text, rig);
 }
 
 bool SynthesizeOptions::Check(std::string* error) const {
