@@ -86,6 +86,14 @@ struct DepthEvaluationOptions {
   // median-filtered 7 x 7: 3.23 mm within 20 px, 41% of the hair, and 1.75 mm further in).
   // 0: every hair pixel counts as inside.
   int silhouette_band_px = 20;
+  // Which layer of the hair the depths follow: for each hair pixel with a depth whose k x k
+  // window (true depth map pixels, k = this) is all hair, the fraction of the window's true
+  // depths in front of it (ties count half); the median over those pixels is reported. Hair
+  // is a volume seen through gaps between thin strands: each pixel's truth is the first strand
+  // its centre ray hits, so the true depths of a window scatter over millimetres, and 50% is
+  // the window's median, the README's ideal smooth surface. Below 50% the depths follow the
+  // front of the hair, above it the strands behind. 0: not computed.
+  int layer_window_px = 7;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -102,6 +110,8 @@ struct DepthEvaluationOptions {
     v("strand_spacing_m", &strand_spacing_m, "spline sampling of the true strands (m)");
     v("silhouette_band_px", &silhouette_band_px,
       "hair pixels this close to the background count as near the silhouette (px)");
+    v("layer_window_px", &layer_window_px,
+      "k x k window (odd) of true depths that ranks the layer of each depth (0 = off)");
   }
   bool Check(std::string* error) const;
 };
@@ -127,6 +137,10 @@ struct DepthMetrics {
   double silhouette_median_signed_error_mm = 0;
   double interior_median_abs_error_mm = 0;
   double interior_median_signed_error_mm = 0;
+  // Median layer of the depths (DepthEvaluationOptions::layer_window_px): the fraction of the
+  // true depths around a pixel in front of its depth, 0.5 = the local median of the truth.
+  long num_layer_pixels = 0;
+  double median_layer = 0;
   // 3D: back-projected with the workspace's camera, distance to the nearest true strand.
   long num_points_3d = 0;
   double accuracy_3d_mean_mm = 0;

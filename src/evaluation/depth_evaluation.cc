@@ -33,9 +33,11 @@ struct DepthSamples {
   // depth - true depth of the hair pixels with a depth, near the silhouette or not.
   std::vector<double> silhouette_errors_m, interior_errors_m;
   std::vector<double> distances_3d_m;  // a subset of them, back-projected
+  std::vector<double> layers;          // of the pixels whose true depth window is all hair
 
   void Append(const DepthSamples& other) {
     num_hair_pixels += other.num_hair_pixels;
+    layers.insert(layers.end(), other.layers.begin(), other.layers.end());
     for (auto [to, from] : {std::pair(&silhouette_errors_m, &other.silhouette_errors_m),
                             std::pair(&interior_errors_m, &other.interior_errors_m),
                             std::pair(&distances_3d_m, &other.distances_3d_m)}) {
@@ -48,6 +50,23 @@ struct DepthSamples {
 // the middle two, as for the distances).
 double MedianMm(const std::vector<double>& values_m) {
   return SummarizeDistances(values_m).median_mm;
+}
+
+// The fraction of the true hair depths of the k x k window around gt pixel (r, c) that lie in
+// front of `depth` (ties count half); -1 when the window leaves the image or holds a pixel
+// that is not hair.
+double LayerInWindow(const GroundTruthView& gt, int r, int c, int k, double depth) {
+  const int width = gt.depth.Width(), height = gt.depth.Height(), half = k / 2;
+  if (r < half || c < half || r + half >= height || c + half >= width) return -1;
+  double in_front = 0;
+  for (int wr = r - half; wr <= r + half; ++wr) {
+    for (int wc = c - half; wc <= c + half; ++wc) {
+      if (gt.label[static_cast<size_t>(wr) * width + wc] != kLabelHair) return -1;
+      const double truth = gt.depth.At(wr, wc);
+      in_front += truth < depth ? 1.0 : truth == depth ? 0.5 : 0.0;
+    }
+  }
+  return in_front / (k * k);
 }
 
 std::vector<double> Absolute(std::vector<double> values) {
@@ -85,6 +104,8 @@ DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   m.silhouette_median_signed_error_mm = MedianMm(samples.silhouette_errors_m);
   m.interior_median_abs_error_mm = MedianMm(Absolute(samples.interior_errors_m));
   m.interior_median_signed_error_mm = MedianMm(samples.interior_errors_m);
+  m.num_layer_pixels = static_cast<long>(samples.layers.size());
+  m.median_layer = Percentile(samples.layers, 0.5);
   const DistanceStats accuracy = SummarizeDistances(samples.distances_3d_m);
   m.num_points_3d = accuracy.count;
   m.accuracy_3d_mean_mm = accuracy.mean_mm;
@@ -109,6 +130,8 @@ nlohmann::json ToJson(const DepthMetrics& m) {
           {"silhouette_median_signed_error_mm", m.silhouette_median_signed_error_mm},
           {"interior_median_abs_error_mm", m.interior_median_abs_error_mm},
           {"interior_median_signed_error_mm", m.interior_median_signed_error_mm},
+          {"num_layer_pixels", m.num_layer_pixels},
+          {"median_layer", m.median_layer},
           {"num_points_3d", m.num_points_3d},
           {"accuracy_3d_mean_mm", m.accuracy_3d_mean_mm},
           {"accuracy_3d_median_mm", m.accuracy_3d_median_mm},
@@ -119,13 +142,14 @@ std::string TableRow(const DepthMetrics& m) {
   char line[256];
   std::snprintf(line, sizeof(line),
                 "%-14s %9ld %7.1f%% %8.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %8.3f %8.3f %7.2f"
-                " %6.1f%% %7.2f %7.2f %7.2f %7.2f\n",
+                " %6.1f%% %7.2f %7.2f %7.2f %7.2f %5.0f%%\n",
                 m.name.c_str(), m.num_hair_pixels, 100 * m.completeness, m.mean_abs_error_mm,
                 m.median_abs_error_mm, 100 * m.within_1mm, 100 * m.within_2mm,
                 100 * m.within_5mm, m.accuracy_3d_mean_mm, m.accuracy_3d_median_mm,
                 m.median_signed_error_mm, 100 * m.silhouette_fraction,
                 m.silhouette_median_abs_error_mm, m.silhouette_median_signed_error_mm,
-                m.interior_median_abs_error_mm, m.interior_median_signed_error_mm);
+                m.interior_median_abs_error_mm, m.interior_median_signed_error_mm,
+                100 * m.median_layer);
   return line;
 }
 
@@ -148,6 +172,10 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
     *error = "EvaluateDepth.silhouette_band_px must be >= 0";
     return false;
   }
+  if (layer_window_px < 0 || (layer_window_px > 0 && layer_window_px % 2 == 0)) {
+    *error = "EvaluateDepth.layer_window_px must be 0 or odd";
+    return false;
+  }
   if (!(strand_spacing_m > 0)) {
     *error = "EvaluateDepth.strand_spacing_m must be > 0";
     return false;
@@ -157,10 +185,11 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
 
 std::string DepthEvaluationResult::Table() const {
   // sil = hair pixels within silhouette_band_px of the background, int = the others;
-  // signed medians (sgn) > 0: behind the truth.
+  // signed medians (sgn) > 0: behind the truth; layer: median fraction of the true depths
+  // around a pixel in front of its depth (50% = their median).
   return EvaluationTable(
       "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
-      "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn\n",
+      "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn  layer\n",
       views, overall, json_path, TableRow);
 }
 
@@ -260,6 +289,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
             distance_to_background.at<float>(gr, gc) <= silhouette_band_gt_px;
         (near_silhouette ? samples.silhouette_errors_m : samples.interior_errors_m)
             .push_back(signed_error);
+        if (options.layer_window_px > 0) {
+          const double layer = LayerInWindow(gt, gr, gc, options.layer_window_px, d);
+          if (layer >= 0) samples.layers.push_back(layer);
+        }
         const double abs_error = std::abs(signed_error);
         const double level = std::min(1.0, 1e3 * abs_error / options.error_image_max_mm);
         levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * level));

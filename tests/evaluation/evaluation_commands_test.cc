@@ -272,6 +272,56 @@ TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
   EXPECT_NE(error.find("silhouette_band_px"), std::string::npos) << error;
 }
 
+TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
+  const Scene scene = MakeScene("layer");
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  // v1 sees the plane at a slant: its true depth grows by ~0.07 mm per column, so a 7 x 7
+  // window holds three columns in front of its centre and three behind.
+  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v1.png");
+  long num_full_windows = 0;
+  for (int r = 3; r + 3 < kHeight; ++r) {
+    for (int c = 3; c + 3 < kWidth; ++c) {
+      bool all_hair = true;
+      for (int wr = r - 3; wr <= r + 3; ++wr) {
+        for (int wc = c - 3; wc <= c + 3; ++wc) {
+          all_hair = all_hair && truth.label[wr * kWidth + wc] == kLabelHair;
+        }
+      }
+      num_full_windows += all_hair;
+    }
+  }
+  ASSERT_GT(num_full_windows, 500);
+  const std::string v1 = JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin");
+  const FloatMap exact = ReadMat(v1);
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v1.png"};
+  options.write_error_images = false;
+  auto layer_with_offset = [&](float offset_m) {
+    FloatMap depth = exact;
+    for (float& d : depth.Data()) d = d > 0 ? d + offset_m : 0.0f;
+    WriteMat(v1, depth);
+    const DepthMetrics m = EvaluateDepthMaps(out, scene.gt, options).overall;
+    EXPECT_EQ(m.num_layer_pixels, num_full_windows);
+    return m.median_layer;
+  };
+  // The truth itself is the median of its window (measured: exactly; a tie between two rows
+  // of one column that float rounding breaks moves it by 1 / 98).
+  EXPECT_NEAR(layer_with_offset(0.0f), 0.5, 0.03);
+  // 1 mm behind: every true depth of the window is in front; 1 mm in front: none.
+  EXPECT_DOUBLE_EQ(layer_with_offset(1e-3f), 1.0);
+  EXPECT_DOUBLE_EQ(layer_with_offset(-1e-3f), 0.0);
+  // 0.1 mm behind: the window's column 1 px behind (+0.07 mm) is in front too, the next not.
+  EXPECT_NEAR(layer_with_offset(1e-4f), 35.0 / 49, 0.03);
+
+  options.layer_window_px = 0;
+  EXPECT_EQ(EvaluateDepthMaps(out, scene.gt, options).overall.num_layer_pixels, 0);
+  options.layer_window_px = 6;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("layer_window_px"), std::string::npos) << error;
+}
+
 // Writes a cost volume for v0 on a 16 x 12 grid (4 x 4 image pixels each) with labels 5 mm
 // apart from 0.45 m (label 10 = 0.5 m, v0's true depth everywhere: it looks straight at the
 // plane z = 0.5), whose cheapest label is `cheapest` at every pixel.
