@@ -9,7 +9,9 @@
 // view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), homography,
 // 0 with psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5. homography = 1: the
 // reference orientation is instead carried into view j by the Jacobian of the fronto-parallel
-// plane's homography at the pixel (TransferDirection in src/stereo/stereo_geometry.h).
+// plane's homography at the pixel (TransferDirection in src/stereo/stereo_geometry.h): the
+// plane of the strands, fronto-parallel, or tilted by log_depth_gradient (2 planes, the
+// gradient of log depth per pixel) when has_gradient.
 // view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
 // The reference orientation field is planar (Re plane, then Im plane); the source fields are
 // interleaved (Re, Im per pixel), since they are sampled at scattered points.
@@ -63,13 +65,16 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
                                __global const int* view_dims, int num_views,
                                __global const float* label_base, float label_step,
                                int slice_begin, float depth_a, float depth_b, int inverse_depth,
-                               __global float* cost) {
+                               __global float* cost, __global const float* log_depth_gradient,
+                               int has_gradient) {
   const int col = get_global_id(0);
   const int row = get_global_id(1);
   const int k = get_global_id(2);
   if (col >= width || row >= height) return;
   const int p = row * width + col;
   const int plane = width * height;
+  const float gx = has_gradient ? log_depth_gradient[p] : 0.0f;
+  const float gy = has_gradient ? log_depth_gradient[plane + p] : 0.0f;
   const float ore = ref[p];
   const float oim = ref[plane + p];
   float total = 0.0f;
@@ -98,8 +103,14 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
         const float c2 = ore / r;
         const float ct = sqrt(fmax(0.0f, 0.5f * (1.0f + c2)));
         const float st = copysign(sqrt(fmax(0.0f, 0.5f * (1.0f - c2))), oim);
-        const float dx = (m[0] - px * m[6]) * ct + (m[1] - px * m[7]) * st;
-        const float dy = (m[3] - py * m[6]) * ct + (m[4] - py * m[7]) * st;
+        // The strand's plane tilts by the gradient g of log depth: direction H ((ct, st, 0) +
+        // (g . (ct, st)) (x, y, 1)), then the Jacobian of the division by u.z.
+        const float kappa = gx * ct + gy * st;
+        const float hx = m[0] * ct + m[1] * st + kappa * (m[0] * x + m[1] * y + m[2]);
+        const float hy = m[3] * ct + m[4] * st + kappa * (m[3] * x + m[4] * y + m[5]);
+        const float hz = m[6] * ct + m[7] * st + kappa * (m[6] * x + m[7] * y + m[8]);
+        const float dx = hx - px * hz;
+        const float dy = hy - py * hz;
         const float scale = r / (dx * dx + dy * dy);
         total -= scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
       } else {

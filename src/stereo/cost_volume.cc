@@ -94,6 +94,17 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
   if (cost == StereoCost::kOrientation) {
     sources_ = Upload(context, all_sources.data(), sizeof(float) * all_sources.size());
     orientation_kernel_ = cl::Kernel(CostProgram(context), "orientation_cost");
+    const FloatMap& gradient = ref.log_depth_gradient;
+    has_gradient_ = gradient.Empty() ? 0 : 1;
+    if (has_gradient_) {
+      CHECK_EQ(gradient.Width(), width_);
+      CHECK_EQ(gradient.Height(), height_);
+      CHECK_EQ(gradient.Channels(), 2);
+    }
+    const float unused[2] = {0, 0};
+    log_depth_gradient_ = has_gradient_ ? Upload(context, gradient.Data().data(),
+                                                 sizeof(float) * gradient.Data().size())
+                                        : Upload(context, unused, sizeof(unused));
   } else {
     box_ = std::make_unique<BoxFilterCL>(context);
     warp_kernel_ = cl::Kernel(CostProgram(context), "photometric_warp");
@@ -140,6 +151,8 @@ void CostVolumeCL::Compute(const cl::Buffer& label_base, float label_step, int s
   k.setArg(a++, static_cast<float>(labels.b));
   k.setArg(a++, static_cast<int>(labels.inverse));
   k.setArg(a++, out);
+  k.setArg(a++, log_depth_gradient_);
+  k.setArg(a++, has_gradient_);
   context_->Queue().enqueueNDRangeKernel(k, cl::NullRange,
                                          cl::NDRange(width_, height_, num_slices));
 }
@@ -227,14 +240,21 @@ FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostView
           const std::complex<double> o_src(re, im);
           std::complex<double> carried = o_ref * std::polar(1.0, -psi[v]);
           if (transfer == OrientationTransfer::kPlaneHomography && std::abs(o_ref) > 0) {
-            // The strand through the pixel at angle theta = arg(O_ref) / 2, kept at the same
-            // depth (the fronto-parallel plane): project a short piece of it, both ways.
+            // The strand through the pixel at angle theta = arg(O_ref) / 2, in its plane:
+            // project a short piece of it, both ways. The plane's inverse depth is affine in
+            // the image, 1 / z(x + d) = (1 - g . d) / D (g = 0: the fronto-parallel plane).
             const double theta = 0.5 * std::arg(o_ref), step = 1e-3;
+            const double dx = step * std::cos(theta), dy = step * std::sin(theta);
+            double g_dot_d = 0;
+            if (!ref.log_depth_gradient.Empty()) {
+              g_dot_d = ref.log_depth_gradient.At(row, col, 0) * dx +
+                        ref.log_depth_gradient.At(row, col, 1) * dy;
+            }
             double xa, ya, xb, yb;
-            ProjectCpu(ref, sources[v], x_ref - step * std::cos(theta),
-                       y_ref - step * std::sin(theta), depth, &xa, &ya);
-            ProjectCpu(ref, sources[v], x_ref + step * std::cos(theta),
-                       y_ref + step * std::sin(theta), depth, &xb, &yb);
+            ProjectCpu(ref, sources[v], x_ref - dx, y_ref - dy, depth / (1 + g_dot_d), &xa,
+                       &ya);
+            ProjectCpu(ref, sources[v], x_ref + dx, y_ref + dy, depth / (1 - g_dot_d), &xb,
+                       &yb);
             carried = std::polar(std::abs(o_ref), 2.0 * std::atan2(yb - ya, xb - xa));
           }
           total -= (std::conj(carried) * o_src).real();

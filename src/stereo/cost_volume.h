@@ -9,6 +9,7 @@
 // Slice k of a block is label v = label_base[p] + (slice_begin + k) * label_step.
 
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "hairmvs/orientation_stereo.h"
@@ -24,8 +25,17 @@ class OpenCLContext;
 // A view at one level: its camera on the field's grid (a pyramid level's:
 // StereoCamera::PyramidLevel) and its field: orientation (2 channels) or colour (3 channels).
 struct CostViewInput {
+  CostViewInput() = default;
+  CostViewInput(const StereoCamera& camera_in, FloatMap field_in,
+                FloatMap log_depth_gradient_in = FloatMap())
+      : camera(camera_in), field(std::move(field_in)),
+        log_depth_gradient(std::move(log_depth_gradient_in)) {}
+
   StereoCamera camera;
   FloatMap field;
+  // The reference's, for the plane_homography transfer: the gradient of log depth of the plane
+  // its strands lie in, per pixel (LogDepthGradient; 2 channels). Empty: fronto-parallel.
+  FloatMap log_depth_gradient;
 };
 
 class CostVolumeCL {
@@ -56,6 +66,8 @@ class CostVolumeCL {
   cl::Buffer sources_;
   cl::Buffer params_;
   cl::Buffer dims_;
+  cl::Buffer log_depth_gradient_;  // 2 planes, or 2 floats unused when has_gradient_ is 0
+  int has_gradient_ = 0;
   std::vector<std::array<int, 2>> source_sizes_;
   std::vector<cl::Buffer> source_buffers_;  // photometric: one colour image per view
   std::vector<cl::Buffer> source_params_;   // photometric: 16 floats per view

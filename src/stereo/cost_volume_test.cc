@@ -60,6 +60,18 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
   const FloatMap plane = OrientationCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 7,
                                             labels, OrientationTransfer::kPlaneHomography);
   EXPECT_GT(MaxAbsDiff(roll, plane), 0.05f);
+  // The strands' plane tilted per pixel (gradients of log depth up to 0.03 per level-1 pixel:
+  // planes up to 56 degrees from the image plane at this focal length of 50 px).
+  Scene tilted = scene;
+  tilted.ref.log_depth_gradient = RandomMap(48, 36, 2, 4, -0.03f, 0.03f);
+  CostVolumeCL tilted_volume(context.get(), StereoCost::kOrientation, tilted.ref,
+                             tilted.sources, OrientationTransfer::kPlaneHomography);
+  const FloatMap tilted_cpu = OrientationCostCpu(tilted.ref, tilted.sources, tilted.base, 0.75f,
+                                                 5, 7, labels,
+                                                 OrientationTransfer::kPlaneHomography);
+  EXPECT_LT(MaxAbsDiff(tilted_volume.Compute(tilted.base, 0.75f, 5, 7, labels), tilted_cpu),
+            2e-4f);
+  EXPECT_GT(MaxAbsDiff(tilted_cpu, plane), 0.05f);
   // Uniform-in-depth labels too.
   const DepthLabels linear(0.6, 2.0, 32, false);
   CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources,

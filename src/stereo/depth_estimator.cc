@@ -239,7 +239,7 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
 
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
                                const std::vector<const StereoViewData*>& sources,
-                               const FloatMap& mask, const FloatMap& depth_lower_bound,
+                               const FloatMap& mask, const FloatMap& visual_hull_entry,
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
                                Progress* progress, const GeometricPrior* prior,
@@ -267,6 +267,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   auto guide = [&](int l) -> const FloatMap& {
     return scaled_guides.empty() ? ref.orientation[l] : scaled_guides[l];
   };
+  const bool strand_plane_from_hull =
+      !photometric && options.orientation_transfer == OrientationTransfer::kPlaneHomography &&
+      options.strand_plane_from_visual_hull && !visual_hull_entry.Empty();
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
@@ -277,6 +280,11 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
       };
       // Level cameras as the pyramid makes the levels (CostVolumeCL checks their sizes).
       CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref)};
+      if (strand_plane_from_hull) {
+        ref_in.log_depth_gradient = LogDepthGradient(
+            visual_hull_entry, l, ref_in.field.Width(), ref_in.field.Height(),
+            ref.camera.K(0, 0), options.max_strand_plane_tilt_deg);
+      }
       std::vector<CostViewInput> src_in;
       for (const StereoViewData* src : sources) {
         src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
@@ -405,15 +413,17 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                       LevelPixelsPerPixel(0, coarse_level), labels, {}, 1.0f, num_depths,
                       prior_scale, &coarse_volume);
   }
-  // The depth lower bound as labels on the level-0 grid (-inf = none).
+  // The depth lower bound (the hull's entry less the tolerance) as labels on the level-0 grid
+  // (-inf = none).
   std::vector<float> bound0;
-  if (!depth_lower_bound.Empty()) {
-    CHECK_EQ(depth_lower_bound.Width(), width0);
-    CHECK_EQ(depth_lower_bound.Height(), height0);
+  if (!visual_hull_entry.Empty() && options.visual_hull_depth_bound != VisualHullBound::kOff) {
+    CHECK_EQ(visual_hull_entry.Width(), width0);
+    CHECK_EQ(visual_hull_entry.Height(), height0);
+    const float tolerance = static_cast<float>(options.visual_hull_tolerance_m);
     bound0.assign(static_cast<size_t>(width0) * height0, -std::numeric_limits<float>::infinity());
     for (size_t p = 0; p < bound0.size(); ++p) {
-      const float d = depth_lower_bound.Data()[p];
-      if (d > 0) bound0[p] = static_cast<float>(labels.Label(d));
+      const float d = visual_hull_entry.Data()[p] - tolerance;
+      if (visual_hull_entry.Data()[p] > 0 && d > 0) bound0[p] = static_cast<float>(labels.Label(d));
     }
   }
   const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;

@@ -75,13 +75,14 @@ void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_cam
 // prior or bound, which depends only on the views, labels and options; used (and emptied) when
 // it holds a volume of the coarse grid's size, filled when empty (the geometric pass estimates
 // each view again from the same data: the all-label volume is most of an estimate's work).
-// `depth_lower_bound` (level-0 grid, metres, 0 = none; may be empty), per
+// `visual_hull_entry` (level-0 grid, metres, 0 = none; may be empty): where each pixel's ray
+// enters the masks' visual hull. Less options.visual_hull_tolerance_m it bounds the depth, per
 // options.visual_hull_depth_bound: kFilter, depths that end in front of it are invalid (0);
 // kPenalty, labels in front of it get the pixel's worst cost plus one cost range per label of
-// excess, in both stages.
+// excess, in both stages. Its tilt gives the strands' plane (strand_plane_from_visual_hull).
 DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
                                const std::vector<const StereoViewData*>& sources,
-                               const FloatMap& mask, const FloatMap& depth_lower_bound,
+                               const FloatMap& mask, const FloatMap& visual_hull_entry,
                                const DepthLabels& labels,
                                const OrientationStereoOptions& options, StageTimings* timings,
                                Progress* progress = nullptr,

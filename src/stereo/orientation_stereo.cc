@@ -40,12 +40,13 @@ struct ViewEstimate {
   Eigen::Matrix3d K;  // the camera of the depth map's grid
 };
 
-// Where a view's depth is searched: the label range and the visual-hull lower bound.
+// Where a view's depth is searched: the label range, and where each pixel's ray enters the
+// masks' visual hull (the depth bound and the strands' plane; EstimateDepthMap).
 struct DepthSearch {
   double depth_min = 0;
   double depth_max = 0;  // 0: not computed yet
   std::string range_source;
-  FloatMap depth_lower_bound;
+  FloatMap visual_hull_entry;
 };
 
 // What the geometric pass would compute again for a view, kept from its first estimate: the
@@ -54,7 +55,7 @@ struct FirstEstimate {
   DepthSearch search;
   std::vector<float> coarse_volume;
   size_t Bytes() const {
-    return sizeof(float) * (coarse_volume.size() + search.depth_lower_bound.Data().size());
+    return sizeof(float) * (coarse_volume.size() + search.visual_hull_entry.Data().size());
   }
 };
 
@@ -122,6 +123,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (visual_hull_mask_dilation_px < 0) e << "visual_hull_mask_dilation_px must be >= 0; ";
   if (visual_hull_min_carving_views < 1) e << "visual_hull_min_carving_views must be >= 1; ";
   if (num_levels < 1) e << "num_levels must be >= 1; ";
+  if (!(max_strand_plane_tilt_deg >= 0 && max_strand_plane_tilt_deg < 90)) {
+    e << "max_strand_plane_tilt_deg must be in [0, 90); ";
+  }
   if (window_px_level0 < 1 || window_px_level1 < 1 || window_px_level2 < 1) {
     e << "window_px_level* must be >= 1; ";
   }
@@ -480,8 +484,13 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       THROW_IF(!(depth_min > 0 && depth_max > depth_min),
                name << ": no depth range (too few sparse points seen by this view?); give "
                     << "--OrientationStereo.depth_min and depth_max");
-      // Per pixel, where its ray enters the visual hull: a lower bound on its depth.
-      if (options.visual_hull_depth_bound != VisualHullBound::kOff &&
+      // Per pixel, where its ray enters the visual hull: a lower bound on its depth, and the
+      // surface whose tilt the strands' plane takes.
+      const bool strand_plane_from_hull =
+          options.cost == StereoCost::kOrientation &&
+          options.orientation_transfer == OrientationTransfer::kPlaneHomography &&
+          options.strand_plane_from_visual_hull;
+      if ((options.visual_hull_depth_bound != VisualHullBound::kOff || strand_plane_from_hull) &&
           !workspace.MaskPath(name).empty()) {
         ScopedStageTimer timer(timings, "visual hull");
         VisualHullRangeOptions every_pixel_entries;
@@ -491,14 +500,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         const FloatMap intervals =
             VisualHullIntervals(ref.camera, mask, others(), 0.5 * depth_min,
                                 2 * depth_max, every_pixel_entries);
-        search.depth_lower_bound = FloatMap(intervals.Width(), intervals.Height(), 1);
-        for (size_t p = 0; p < intervals.NumPixels(); ++p) {
-          const float near_m = intervals.Channel(0)[p];
-          search.depth_lower_bound.Data()[p] =
-              near_m > 0 ? std::max(0.0f, near_m - static_cast<float>(
-                                                       options.visual_hull_tolerance_m))
-                         : 0.0f;
-        }
+        search.visual_hull_entry = FloatMap(intervals.Width(), intervals.Height(), 1);
+        std::copy_n(intervals.Channel(0), intervals.NumPixels(),
+                    search.visual_hull_entry.Data().begin());
       }
       search.depth_min = depth_min;
       search.depth_max = depth_max;
@@ -509,7 +513,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                              options.depth_sampling == DepthSampling::kInverseDepth);
 
     DepthEstimate estimate = EstimateDepthMap(
-        context.get(), ref, sources, mask, search.depth_lower_bound, labels, options, timings,
+        context.get(), ref, sources, mask, search.visual_hull_entry, labels, options, timings,
         progress, prior, cache != nullptr ? &cache->coarse_volume : nullptr);
 
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "

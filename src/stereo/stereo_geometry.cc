@@ -1,6 +1,7 @@
 #include "src/stereo/stereo_geometry.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 #include "src/core/logging.h"
@@ -73,15 +74,51 @@ double LevelPixelsPerPixel(int level, int grid_level) {
 }
 
 Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth, double x,
-                                  double y, const Eigen::Vector2d& direction) {
-  // u(x, y) = D H (x, y, 1) + b; the image point is (u.x / u.z, u.y / u.z). Its Jacobian is
-  // D / u.z times rows (H_0 - p_x H_2) and (H_1 - p_y H_2) (first two columns); D / u.z > 0
-  // in front of the source.
+                                  double y, const Eigen::Vector2d& direction,
+                                  const Eigen::Vector2d& log_depth_gradient) {
+  // u(x, y) = D H (x, y, 1) + b; the image point is (u.x / u.z, u.y / u.z). Moving along the
+  // strand changes u by (a positive multiple of) h = H ((t, 0) + (g . t) (x, y, 1)), and the
+  // image point by (h.x - p_x h.z, h.y - p_y h.z) / u.z, u.z > 0 in front of the source.
   const Eigen::Matrix3d& H = projection.H;
-  const Eigen::Vector3d u = depth * H * Eigen::Vector3d(x, y, 1.0) + projection.b;
+  const Eigen::Vector3d x_h(x, y, 1.0);
+  const Eigen::Vector3d u = depth * H * x_h + projection.b;
   const double px = u.x() / u.z(), py = u.y() / u.z();
-  return {(H(0, 0) - px * H(2, 0)) * direction.x() + (H(0, 1) - px * H(2, 1)) * direction.y(),
-          (H(1, 0) - py * H(2, 0)) * direction.x() + (H(1, 1) - py * H(2, 1)) * direction.y()};
+  const Eigen::Vector3d h =
+      H * (Eigen::Vector3d(direction.x(), direction.y(), 0.0) +
+           log_depth_gradient.dot(direction) * x_h);
+  return {h.x() - px * h.z(), h.y() - py * h.z()};
+}
+
+FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
+                          double focal_px, double max_tilt_deg) {
+  CHECK_EQ(depth0.Channels(), 1);
+  FloatMap gradient(width, height, 2, 0.0f);
+  const int scale = 1 << level;
+  const int step = std::max(2, scale);
+  const double max_norm = std::tan(max_tilt_deg * M_PI / 180.0) / focal_px;
+  auto log_depth = [&](int r, int c, double* value) {
+    if (r < 0 || c < 0 || r >= depth0.Height() || c >= depth0.Width()) return false;
+    const float d = depth0.At(r, c);
+    if (!(d > 0)) return false;
+    *value = std::log(static_cast<double>(d));
+    return true;
+  };
+  for (int r = 0; r < height; ++r) {
+    const int r0 = std::min(depth0.Height() - 1, r * scale + scale / 2);
+    for (int c = 0; c < width; ++c) {
+      const int c0 = std::min(depth0.Width() - 1, c * scale + scale / 2);
+      double left, right, up, down;
+      if (!log_depth(r0, c0 - step, &left) || !log_depth(r0, c0 + step, &right) ||
+          !log_depth(r0 - step, c0, &up) || !log_depth(r0 + step, c0, &down)) {
+        continue;
+      }
+      Eigen::Vector2d g((right - left) / (2 * step), (down - up) / (2 * step));
+      if (g.norm() > max_norm) g *= max_norm / g.norm();
+      gradient.At(r, c, 0) = static_cast<float>(scale * g.x());
+      gradient.At(r, c, 1) = static_cast<float>(scale * g.y());
+    }
+  }
+  return gradient;
 }
 
 DepthLabels::DepthLabels(double depth_min_in, double depth_max_in, int num_labels_in,

@@ -9,6 +9,7 @@
 #include <array>
 
 #include "hairmvs/orientation_stereo.h"
+#include "src/core/float_map.h"
 
 namespace hairmvs {
 
@@ -54,11 +55,26 @@ ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera
 double LevelPixelsPerPixel(int level, int grid_level);
 
 // The direction, in the source image, of a strand that passes through the reference image
-// point (x, y) with direction (dx, dy) and lies in the fronto-parallel plane at its depth: the
-// plane's homography x -> H x (up to scale; b / D shifts it) applied to the direction, i.e. its
-// Jacobian at (x, y). Scaled by an unspecified positive factor.
+// point (x, y) at depth D with direction t = (dx, dy) and lies in a plane: the Jacobian at
+// (x, y) of the map through that plane into the source, applied to t. The plane is given by the
+// gradient g of its log depth at (x, y) (pixel units; zero: fronto-parallel): its points near
+// (x, y) lie at 1 / z(x + d) = (1 - g . d) / D, so the strand's 3D direction is
+// D K^-1 ((t, 0) + (g . t) (x, y, 1)) and the source sees H times that. Scaled by an
+// unspecified positive factor.
 Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth, double x,
-                                  double y, const Eigen::Vector2d& direction);
+                                  double y, const Eigen::Vector2d& direction,
+                                  const Eigen::Vector2d& log_depth_gradient =
+                                      Eigen::Vector2d::Zero());
+
+// The tilt of a surface as TransferDirection takes it: the gradient of log depth at the pixels
+// of pyramid level `level` (width x height; 2 channels, x and y, in that level's pixel units)
+// of a depth map on the level-0 grid (metres, 0 = none), by central differences over
+// +-max(2, 2^level) level-0 pixels around the level-0 pixel nearest the level pixel's centre;
+// 0 where one of the four has no depth. Magnitudes are clamped at tan(max_tilt_deg) /
+// focal_px (focal_px of level 0): a plane seen at max_tilt_deg from the image plane on the
+// optical axis.
+FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
+                          double focal_px, double max_tilt_deg);
 
 // Angle (radians, modulo pi is what matters) between the image +x axis and the vector from the
 // principal point of `camera` to the epipole of the camera centred at `other_center`.

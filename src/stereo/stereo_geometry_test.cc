@@ -100,6 +100,106 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
   EXPECT_GT(worst_roll_error, 0.01);
 }
 
+// A strand in a plane tilted 50 degrees towards the source (as hair on the side of a head):
+// given the gradient of the plane's log depth, TransferDirection gives its direction in the
+// source; taken as fronto-parallel, it misses.
+TEST(StereoGeometry, TiltedPlaneCarriesAStrandDirectionIntoTheSource) {
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 100, 96, 72);
+  const StereoCamera src = LookAtCamera({0.5, -0.1, 0.1}, {0, 0, 1}, 100, 96, 72, 0.1);
+  const ViewProjection proj =
+      ComputeViewProjection(ref, src, OrientationTransfer::kPlaneHomography);
+  auto image_point = [](const StereoCamera& c, const Eigen::Vector3d& p) {
+    return Eigen::Vector2d((c.K * (c.R * p + c.t)).hnormalized());
+  };
+  const double tilt = 50 * M_PI / 180;
+  const Eigen::Vector3d a(0.07, -0.04, 1.0);
+  const Eigen::Vector3d normal(std::sin(tilt), 0.2, -std::cos(tilt));
+  const Eigen::Vector2d x = image_point(ref, a);
+  // The plane's z-depth along the ray of image point p (in the reference's frame), and its log
+  // gradient at x.
+  const Eigen::Vector3d a_ref = ref.R * a + ref.t, normal_ref = ref.R * normal;
+  auto plane_depth = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector3d ray = ref.K.inverse() * p.homogeneous();
+    return normal_ref.dot(a_ref) / normal_ref.dot(ray);
+  };
+  const double h = 1e-3;
+  const Eigen::Vector2d gradient(
+      (std::log(plane_depth(x + Eigen::Vector2d(h, 0))) -
+       std::log(plane_depth(x - Eigen::Vector2d(h, 0)))) / (2 * h),
+      (std::log(plane_depth(x + Eigen::Vector2d(0, h))) -
+       std::log(plane_depth(x - Eigen::Vector2d(0, h)))) / (2 * h));
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u).normalized();
+  double worst_fronto_parallel_sine = 0;
+  for (double angle : {0.0, 0.5, 1.2, 2.0, 2.7}) {
+    const Eigen::Vector3d b = a + 1e-4 * (std::cos(angle) * u + std::sin(angle) * v);
+    const Eigen::Vector2d in_ref = image_point(ref, b) - image_point(ref, a);
+    const Eigen::Vector2d in_src = image_point(src, b) - image_point(src, a);
+    auto sine = [&](const Eigen::Vector2d& got) {
+      return std::abs(got.x() * in_src.y() - got.y() * in_src.x()) /
+             (got.norm() * in_src.norm());
+    };
+    EXPECT_NEAR(
+        sine(TransferDirection(proj, a_ref.z(), x.x(), x.y(), in_ref.normalized(), gradient)),
+        0.0,
+        1e-3)
+        << "angle " << angle;
+    worst_fronto_parallel_sine = std::max(
+        worst_fronto_parallel_sine,
+        sine(TransferDirection(proj, a_ref.z(), x.x(), x.y(), in_ref.normalized())));
+  }
+  EXPECT_GT(worst_fronto_parallel_sine, 0.1);  // more than 6 degrees off
+}
+
+// LogDepthGradient on the depth map of a tilted plane (odd size): the plane's gradient of log
+// depth at levels 0 and 1 (twice as large per level-1 pixel), clamped for a steep one, and 0
+// next to a pixel without depth.
+TEST(StereoGeometry, LogDepthGradientOfAPlane) {
+  const int width = 33, height = 21;
+  const double focal = 40;
+  const StereoCamera camera = LookAtCamera({0, 0, 0}, {0, 0, 1}, focal, width, height);
+  // The plane n . X = 1 (camera frame): z(p) = 1 / (n . K^-1 p).
+  auto depth_map = [&](const Eigen::Vector3d& n) {
+    FloatMap depth(width, height, 1);
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) {
+        depth.At(r, c) = static_cast<float>(
+            1.0 / n.dot(camera.K.inverse() * Eigen::Vector3d(c + 0.5, r + 0.5, 1.0)));
+      }
+    }
+    return depth;
+  };
+  // d log z / dp = -(n . K^-1 e) / (n . K^-1 p) for the image axes e.
+  auto expected = [&](const Eigen::Vector3d& n, double x, double y) {
+    const double denominator = n.dot(camera.K.inverse() * Eigen::Vector3d(x, y, 1.0));
+    return Eigen::Vector2d(-n.x() / focal / denominator, -n.y() / focal / denominator);
+  };
+  const Eigen::Vector3d gentle(0.3, -0.2, 1.0);  // about 20 degrees
+  const FloatMap depth = depth_map(gentle);
+  const FloatMap level0 = LogDepthGradient(depth, 0, width, height, focal, 70);
+  const Eigen::Vector2d g0 = expected(gentle, 16.5, 10.5);
+  EXPECT_NEAR(level0.At(10, 16, 0), g0.x(), 1e-3 * g0.norm());
+  EXPECT_NEAR(level0.At(10, 16, 1), g0.y(), 1e-3 * g0.norm());
+  EXPECT_EQ(level0.At(1, 16, 0), 0.0f);  // 2 px from the top: no pixel above
+  // Level 1 (17 x 11): level pixel (5, 8) is nearest level-0 pixel (11, 17).
+  const FloatMap level1 = LogDepthGradient(depth, 1, 17, 11, focal, 70);
+  const Eigen::Vector2d g1 = 2 * expected(gentle, 17.5, 11.5);
+  EXPECT_NEAR(level1.At(5, 8, 0), g1.x(), 1e-3 * g1.norm());
+  EXPECT_NEAR(level1.At(5, 8, 1), g1.y(), 1e-3 * g1.norm());
+  // A plane at about 79 degrees on the optical axis: clamped at tan(70 degrees) / focal, its
+  // direction kept.
+  const Eigen::Vector3d steep(5.0, 0.0, 1.0);
+  const FloatMap clamped = LogDepthGradient(depth_map(steep), 0, width, height, focal, 70);
+  EXPECT_NEAR(clamped.At(10, 17, 0), -std::tan(70 * M_PI / 180) / focal, 1e-6);
+  EXPECT_NEAR(clamped.At(10, 17, 1), 0.0, 1e-6);
+  // A hole: the pixels 2 px away in x and y have no gradient.
+  FloatMap holed = depth;
+  holed.At(10, 16) = 0;
+  const FloatMap around_hole = LogDepthGradient(holed, 0, width, height, focal, 70);
+  EXPECT_EQ(around_hole.At(10, 14, 0), 0.0f);
+  EXPECT_EQ(around_hole.At(12, 16, 1), 0.0f);
+  EXPECT_NE(around_hole.At(11, 15, 0), 0.0f);
+}
+
 // An odd-sized image: a bright pixel goes through the box pyramid (DownsampleHalf, as the
 // orientation fields' levels are made) and lands where PyramidLevel projects its point, which
 // the size ratio (Scaled) misses by a pixel at level 2.
