@@ -143,6 +143,59 @@ void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
   }
 }
 
+// The coarse stage's first label at the pixels of pyramid level `level` (width x height) when
+// its labels start at the visual hull: the label of the hull's entry less `tolerance` (the
+// depth bound) at the level-0 pixel nearest the level pixel's centre; 0 where the ray misses
+// the hull. At most the label from which num_labels labels end at 10 x depth_max, only so
+// that the band's depths stay finite in inverse depth (labels past the range's far end cost
+// time, not accuracy: an estimate there is filtered as outside the range).
+std::vector<float> VisualHullLabelBase(const FloatMap& visual_hull_entry, double tolerance,
+                                       const DepthLabels& labels, int level, int width,
+                                       int height) {
+  const int scale = 1 << level;
+  const float top = static_cast<float>(
+      std::max(0.0, labels.Label(10 * labels.depth_max) - (labels.num_labels - 1)));
+  std::vector<float> base(static_cast<size_t>(width) * height, 0.0f);
+  for (int r = 0; r < height; ++r) {
+    const int r0 = std::min(visual_hull_entry.Height() - 1, r * scale + scale / 2);
+    for (int c = 0; c < width; ++c) {
+      const int c0 = std::min(visual_hull_entry.Width() - 1, c * scale + scale / 2);
+      const double bound = visual_hull_entry.At(r0, c0) - tolerance;
+      if (visual_hull_entry.At(r0, c0) > 0 && bound > 0) {
+        base[static_cast<size_t>(r) * width + c] =
+            std::clamp(static_cast<float>(labels.Label(bound)), 0.0f, top);
+      }
+    }
+  }
+  return base;
+}
+
+// The coarse volume ([k][pixel], label base[p] + k) on the range's labels 0 .. num_labels - 1,
+// linearly interpolated between the two nearest k; labels in front of base[p] get the pixel's
+// largest cost.
+FloatMap CostOnRangeLabels(const std::vector<float>& volume, const std::vector<float>& base,
+                           int width, int height, int num_labels) {
+  const size_t n = static_cast<size_t>(width) * height;
+  FloatMap out(width, height, num_labels);
+  for (size_t p = 0; p < n; ++p) {
+    float worst = -std::numeric_limits<float>::infinity();
+    for (int k = 0; k < num_labels; ++k) worst = std::max(worst, volume[k * n + p]);
+    for (int j = 0; j < num_labels; ++j) {
+      const float x = j - base[p];
+      float cost = worst;
+      if (x >= 0) {
+        const int k0 = std::min(static_cast<int>(x), num_labels - 1);
+        const int k1 = std::min(k0 + 1, num_labels - 1);
+        const float f = x - k0;
+        cost = f > 0 ? (1 - f) * volume[k0 * n + p] + f * volume[k1 * n + p]
+                     : volume[k0 * n + p];
+      }
+      out.Channel(j)[p] = cost;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_camera,
@@ -380,13 +433,20 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const int coarse_level = two_stage ? std::min(options.coarse_level, num_levels - 1) : 0;
   const int coarse_first_level = two_stage ? options.coarse_first_level : 0;
 
-  // Coarse stage: every label, on the coarse grid.
+  // Coarse stage: every label, on the coarse grid; from the visual hull's bound on with
+  // coarse_labels_from_visual_hull.
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
-  std::vector<std::vector<float>> zero_base(num_levels);
+  const bool coarse_from_hull = options.coarse_labels_from_visual_hull && !visual_hull_entry.Empty();
+  std::vector<std::vector<float>> coarse_base(num_levels);
   for (int l = 0; l < num_levels; ++l) {
-    zero_base[l].assign(static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
+    coarse_base[l] = coarse_from_hull
+                         ? VisualHullLabelBase(visual_hull_entry, options.visual_hull_tolerance_m,
+                                               labels, l, levels[l].width, levels[l].height)
+                         : std::vector<float>(
+                               static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
   }
   const int cw = levels[coarse_level].width, ch = levels[coarse_level].height;
+  const std::vector<float>& coarse_grid_base = coarse_base[coarse_level];
   const size_t coarse_size = static_cast<size_t>(cw) * ch * num_depths;
   std::vector<float> coarse_volume;
   if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
@@ -395,14 +455,13 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     coarse_volume_cache->clear();
   } else {
     coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
-                                 num_depths, zero_base, 1.0f);
+                                 num_depths, coarse_base, 1.0f);
     if (coarse_volume_cache != nullptr) *coarse_volume_cache = coarse_volume;
   }
   const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
   if (options.write_cost_volume && prior == nullptr) {
     CostVolume& data_term = estimate.coarse_data_term;
-    data_term.cost = FloatMap(cw, ch, num_depths);
-    std::copy(coarse_volume.begin(), coarse_volume.end(), data_term.cost.Data().begin());
+    data_term.cost = CostOnRangeLabels(coarse_volume, coarse_grid_base, cw, ch, num_depths);
     for (int k = 0; k < num_depths; ++k) data_term.label_depths.push_back(labels.Depth(k));
   }
   float prior_scale = 0;
@@ -410,8 +469,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     ScopedStageTimer timer(timings, "geometric prior");
     prior_scale = MedianCostRange(coarse_volume, static_cast<size_t>(cw) * ch, num_depths);
     AddGeometricPrior(*prior, ref.camera.PyramidLevel(coarse_level),
-                      LevelPixelsPerPixel(0, coarse_level), labels, {}, 1.0f, num_depths,
-                      prior_scale, &coarse_volume);
+                      LevelPixelsPerPixel(0, coarse_level), labels, coarse_grid_base, 1.0f,
+                      num_depths, prior_scale, &coarse_volume);
   }
   // The depth lower bound (the hull's entry less the tolerance) as labels on the level-0 grid
   // (-inf = none).
@@ -441,12 +500,13 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         if (std::isfinite(b) && (!std::isfinite(coarse) || b < coarse)) coarse = b;
       }
     }
-    PenalizeInFrontOfBound(bound_coarse, {}, 1.0f, num_depths, &coarse_volume);
+    PenalizeInFrontOfBound(bound_coarse, coarse_grid_base, 1.0f, num_depths, &coarse_volume);
   }
   if (progress != nullptr) progress->Stage("MRF (all depths)");
   const int coarse_pixels = cw * ch;
   const std::vector<int> coarse_labels =
-      solve(coarse_level, num_depths, &coarse_volume, {}, 1.0f, &estimate.coarse_energy);
+      solve(coarse_level, num_depths, &coarse_volume, coarse_grid_base, 1.0f,
+            &estimate.coarse_energy);
 
   FloatMap coarse_value(cw, ch, 1);
   FloatMap coarse_confidence(cw, ch, 1);
@@ -457,7 +517,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
             ? SubpixelOffsets(coarse_volume, coarse_pixels, num_depths, coarse_labels)
             : std::vector<float>(coarse_pixels, 0.0f);
     for (int p = 0; p < coarse_pixels; ++p) {
-      coarse_value.Data()[p] = coarse_labels[p] + offsets[p];
+      coarse_value.Data()[p] = coarse_grid_base[p] + coarse_labels[p] + offsets[p];
       // Confidence: how much worse the best label at least 2 labels away is.
       const int l = coarse_labels[p];
       float other = std::numeric_limits<float>::infinity();

@@ -484,13 +484,14 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       THROW_IF(!(depth_min > 0 && depth_max > depth_min),
                name << ": no depth range (too few sparse points seen by this view?); give "
                     << "--OrientationStereo.depth_min and depth_max");
-      // Per pixel, where its ray enters the visual hull: a lower bound on its depth, and the
-      // surface whose tilt the strands' plane takes.
+      // Per pixel, where its ray enters the visual hull: a lower bound on its depth, where its
+      // coarse labels start, and the surface whose tilt the strands' plane takes.
       const bool strand_plane_from_hull =
           options.cost == StereoCost::kOrientation &&
           options.orientation_transfer == OrientationTransfer::kPlaneHomography &&
           options.strand_plane_from_visual_hull;
-      if ((options.visual_hull_depth_bound != VisualHullBound::kOff || strand_plane_from_hull) &&
+      if ((options.visual_hull_depth_bound != VisualHullBound::kOff || strand_plane_from_hull ||
+           options.coarse_labels_from_visual_hull) &&
           !workspace.MaskPath(name).empty()) {
         ScopedStageTimer timer(timings, "visual hull");
         VisualHullRangeOptions every_pixel_entries;
