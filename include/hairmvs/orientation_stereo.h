@@ -339,6 +339,9 @@ struct OrientationStereoOptions {
   bool Check(std::string* error) const;
   // Window in px of a level (levels beyond 2 reuse the level-2 window).
   int WindowPx(int level) const;
+  // Whether the orientation cost carries strands through planes tilted as the visual hull
+  // (strand_plane_from_visual_hull with the orientation cost and plane_homography).
+  bool StrandPlaneFromVisualHull() const;
 };
 
 struct OrientationStereoResult {

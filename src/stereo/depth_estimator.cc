@@ -145,21 +145,20 @@ void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
 
 // The coarse stage's first label at the pixels of pyramid level `level` (width x height) when
 // its labels start at the visual hull: the label of the hull's entry less `tolerance` (the
-// depth bound) at the level-0 pixel nearest the level pixel's centre; 0 where the ray misses
+// depth bound) at the level pixel's NearestLevel0Pixel; 0 where the ray misses
 // the hull. At most the label from which num_labels labels end at 10 x depth_max, only so
 // that the band's depths stay finite in inverse depth (labels past the range's far end cost
 // time, not accuracy: an estimate there is filtered as outside the range).
 std::vector<float> VisualHullLabelBase(const FloatMap& visual_hull_entry, double tolerance,
                                        const DepthLabels& labels, int level, int width,
                                        int height) {
-  const int scale = 1 << level;
   const float top = static_cast<float>(
       std::max(0.0, labels.Label(10 * labels.depth_max) - (labels.num_labels - 1)));
   std::vector<float> base(static_cast<size_t>(width) * height, 0.0f);
   for (int r = 0; r < height; ++r) {
-    const int r0 = std::min(visual_hull_entry.Height() - 1, r * scale + scale / 2);
+    const int r0 = NearestLevel0Pixel(r, level, visual_hull_entry.Height());
     for (int c = 0; c < width; ++c) {
-      const int c0 = std::min(visual_hull_entry.Width() - 1, c * scale + scale / 2);
+      const int c0 = NearestLevel0Pixel(c, level, visual_hull_entry.Width());
       const double bound = visual_hull_entry.At(r0, c0) - tolerance;
       if (visual_hull_entry.At(r0, c0) > 0 && bound > 0) {
         base[static_cast<size_t>(r) * width + c] =
@@ -320,9 +319,12 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   auto guide = [&](int l) -> const FloatMap& {
     return scaled_guides.empty() ? ref.orientation[l] : scaled_guides[l];
   };
+  if (!visual_hull_entry.Empty()) {
+    CHECK_EQ(visual_hull_entry.Width(), width0);
+    CHECK_EQ(visual_hull_entry.Height(), height0);
+  }
   const bool strand_plane_from_hull =
-      !photometric && options.orientation_transfer == OrientationTransfer::kPlaneHomography &&
-      options.strand_plane_from_visual_hull && !visual_hull_entry.Empty();
+      options.StrandPlaneFromVisualHull() && !visual_hull_entry.Empty();
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
@@ -436,7 +438,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   // Coarse stage: every label, on the coarse grid; from the visual hull's bound on with
   // coarse_labels_from_visual_hull.
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
-  const bool coarse_from_hull = options.coarse_labels_from_visual_hull && !visual_hull_entry.Empty();
+  const bool coarse_from_hull =
+      options.coarse_labels_from_visual_hull && !visual_hull_entry.Empty();
   std::vector<std::vector<float>> coarse_base(num_levels);
   for (int l = 0; l < num_levels; ++l) {
     coarse_base[l] = coarse_from_hull
@@ -476,13 +479,11 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   // (-inf = none).
   std::vector<float> bound0;
   if (!visual_hull_entry.Empty() && options.visual_hull_depth_bound != VisualHullBound::kOff) {
-    CHECK_EQ(visual_hull_entry.Width(), width0);
-    CHECK_EQ(visual_hull_entry.Height(), height0);
     const float tolerance = static_cast<float>(options.visual_hull_tolerance_m);
     bound0.assign(static_cast<size_t>(width0) * height0, -std::numeric_limits<float>::infinity());
     for (size_t p = 0; p < bound0.size(); ++p) {
-      const float d = visual_hull_entry.Data()[p] - tolerance;
-      if (visual_hull_entry.Data()[p] > 0 && d > 0) bound0[p] = static_cast<float>(labels.Label(d));
+      const float entry = visual_hull_entry.Data()[p], d = entry - tolerance;
+      if (entry > 0 && d > 0) bound0[p] = static_cast<float>(labels.Label(d));
     }
   }
   const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;

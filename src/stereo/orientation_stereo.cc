@@ -97,6 +97,11 @@ bool FromString(const std::string& text, VisualHullBound* bound) {
   return EnumFromName(kVisualHullBoundNames, text, bound);
 }
 
+bool OrientationStereoOptions::StrandPlaneFromVisualHull() const {
+  return strand_plane_from_visual_hull && cost == StereoCost::kOrientation &&
+         orientation_transfer == OrientationTransfer::kPlaneHomography;
+}
+
 int OrientationStereoOptions::WindowPx(int level) const {
   if (level <= 0) return window_px_level0;
   if (level == 1) return window_px_level1;
@@ -486,12 +491,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                     << "--OrientationStereo.depth_min and depth_max");
       // Per pixel, where its ray enters the visual hull: a lower bound on its depth, where its
       // coarse labels start, and the surface whose tilt the strands' plane takes.
-      const bool strand_plane_from_hull =
-          options.cost == StereoCost::kOrientation &&
-          options.orientation_transfer == OrientationTransfer::kPlaneHomography &&
-          options.strand_plane_from_visual_hull;
-      if ((options.visual_hull_depth_bound != VisualHullBound::kOff || strand_plane_from_hull ||
-           options.coarse_labels_from_visual_hull) &&
+      if ((options.visual_hull_depth_bound != VisualHullBound::kOff ||
+           options.StrandPlaneFromVisualHull() || options.coarse_labels_from_visual_hull) &&
           !workspace.MaskPath(name).empty()) {
         ScopedStageTimer timer(timings, "visual hull");
         VisualHullRangeOptions every_pixel_entries;

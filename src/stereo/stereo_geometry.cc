@@ -89,6 +89,11 @@ Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth
   return {h.x() - px * h.z(), h.y() - py * h.z()};
 }
 
+int NearestLevel0Pixel(int index, int level, int size0) {
+  const int scale = 1 << level;
+  return std::min(size0 - 1, index * scale + scale / 2);
+}
+
 FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
                           double focal_px, double max_tilt_deg) {
   CHECK_EQ(depth0.Channels(), 1);
@@ -104,9 +109,9 @@ FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int heig
     return true;
   };
   for (int r = 0; r < height; ++r) {
-    const int r0 = std::min(depth0.Height() - 1, r * scale + scale / 2);
+    const int r0 = NearestLevel0Pixel(r, level, depth0.Height());
     for (int c = 0; c < width; ++c) {
-      const int c0 = std::min(depth0.Width() - 1, c * scale + scale / 2);
+      const int c0 = NearestLevel0Pixel(c, level, depth0.Width());
       double left, right, up, down;
       if (!log_depth(r0, c0 - step, &left) || !log_depth(r0, c0 + step, &right) ||
           !log_depth(r0 - step, c0, &up) || !log_depth(r0 + step, c0, &down)) {

@@ -54,6 +54,10 @@ ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera
 // (the levels halve exactly and share the image origin).
 double LevelPixelsPerPixel(int level, int grid_level);
 
+// The level-0 pixel (column or row) nearest the centre of pixel `index` of pyramid level
+// `level`, for a level-0 size of size0 pixels.
+int NearestLevel0Pixel(int index, int level, int size0);
+
 // The direction, in the source image, of a strand that passes through the reference image
 // point (x, y) at depth D with direction t = (dx, dy) and lies in a plane: the Jacobian at
 // (x, y) of the map through that plane into the source, applied to t. The plane is given by the
@@ -69,7 +73,7 @@ Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth
 // The tilt of a surface as TransferDirection takes it: the gradient of log depth at the pixels
 // of pyramid level `level` (width x height; 2 channels, x and y, in that level's pixel units)
 // of a depth map on the level-0 grid (metres, 0 = none), by central differences over
-// +-max(2, 2^level) level-0 pixels around the level-0 pixel nearest the level pixel's centre;
+// +-max(2, 2^level) level-0 pixels around the level pixel's NearestLevel0Pixel;
 // 0 where one of the four has no depth. Magnitudes are clamped at tan(max_tilt_deg) /
 // focal_px (focal_px of level 0): a plane seen at max_tilt_deg from the image plane on the
 // optical axis.
