@@ -8,10 +8,10 @@
 //   u = D * (Hj * (col + 0.5, row + 0.5, 1)) + bj, sample at (u.x / u.z - 0.5, u.y / u.z - 0.5).
 // view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), homography,
 // 0 with psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5. homography = 1: the
-// reference orientation is instead carried into view j by the Jacobian of the fronto-parallel
-// plane's homography at the pixel (TransferDirection in src/stereo/stereo_geometry.h): the
-// plane of the strands, fronto-parallel, or tilted by log_depth_gradient (2 planes, the
-// gradient of log depth per pixel) when has_gradient.
+// reference orientation is instead carried into view j by the Jacobian, at the pixel, of the
+// homography of the plane the strand lies in (TransferDirection in
+// src/stereo/stereo_geometry.h): fronto-parallel, or, when has_gradient, tilted by
+// log_depth_gradient (2 planes: the gradient of log depth per pixel).
 // view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
 // The reference orientation field is planar (Re plane, then Im plane); the source fields are
 // interleaved (Re, Im per pixel), since they are sampled at scattered points.

@@ -214,6 +214,31 @@ TEST(DepthEstimator, CoarseLabelsFromTheVisualHullFollowTheSphere) {
   EXPECT_GT(loose.completeness, 0.5);
 }
 
+// The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) is refused
+// by name. The strands' plane follows the hull only for the orientation cost's plane
+// homography.
+TEST(OrientationStereoOptions, StrandPlaneOptions) {
+  OrientationStereoOptions options;
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  EXPECT_TRUE(options.StrandPlaneFromVisualHull());
+  for (double tilt : {90.0, -1.0}) {
+    options.max_strand_plane_tilt_deg = tilt;
+    error.clear();
+    EXPECT_FALSE(options.Check(&error));
+    EXPECT_NE(error.find("max_strand_plane_tilt_deg"), std::string::npos) << error;
+  }
+  options = OrientationStereoOptions();
+  options.cost = StereoCost::kPhotometric;
+  EXPECT_FALSE(options.StrandPlaneFromVisualHull());
+  options = OrientationStereoOptions();
+  options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
+  EXPECT_FALSE(options.StrandPlaneFromVisualHull());
+  options = OrientationStereoOptions();
+  options.strand_plane_from_visual_hull = false;
+  EXPECT_FALSE(options.StrandPlaneFromVisualHull());
+}
+
 // A rolled source: the reference's orientations must be carried into it, by the paper's epipole
 // roll or by the plane homography (the default).
 TEST(DepthEstimator, OrientationTransferIsNeededForARolledSource) {

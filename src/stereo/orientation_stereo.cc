@@ -41,7 +41,8 @@ struct ViewEstimate {
 };
 
 // Where a view's depth is searched: the label range, and where each pixel's ray enters the
-// masks' visual hull (the depth bound and the strands' plane; EstimateDepthMap).
+// masks' visual hull (the depth bound, the coarse labels' start and the strands' plane;
+// EstimateDepthMap).
 struct DepthSearch {
   double depth_min = 0;
   double depth_max = 0;  // 0: not computed yet
