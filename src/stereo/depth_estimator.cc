@@ -506,8 +506,12 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   if (progress != nullptr) progress->Stage("MRF (all depths)");
   const int coarse_pixels = cw * ch;
   const std::vector<int> coarse_labels =
-      solve(coarse_level, num_depths, &coarse_volume, coarse_grid_base, 1.0f,
-            &estimate.coarse_energy);
+      solve(coarse_level, num_depths, &coarse_volume,
+            // Label values: depths (the base added) or offsets behind the hull (without it).
+            coarse_from_hull && options.coarse_smoothness_along_visual_hull
+                ? std::vector<float>()
+                : coarse_grid_base,
+            1.0f, &estimate.coarse_energy);
 
   FloatMap coarse_value(cw, ch, 1);
   FloatMap coarse_confidence(cw, ch, 1);

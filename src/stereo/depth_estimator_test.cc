@@ -212,6 +212,15 @@ TEST(DepthEstimator, CoarseLabelsFromTheVisualHullFollowTheSphere) {
   EXPECT_LT(loose.median_abs_error_m, 0.01);
   EXPECT_GT(tight.completeness, 0.5);
   EXPECT_GT(loose.completeness, 0.5);
+  // The coarse smoothness on the offsets behind the tight hull: the sphere is recovered, and
+  // differently (the option reaches the MRF).
+  options.coarse_smoothness_along_visual_hull = true;
+  const Result along = reconstruct(true, 0.02);
+  std::printf("sphere, smoothness along the hull: median |error| %.4f m, completeness %.3f\n",
+              along.median_abs_error_m, along.completeness);
+  EXPECT_LT(along.median_abs_error_m, 0.6 * fronto_parallel.median_abs_error_m);
+  EXPECT_GT(along.completeness, 0.5);
+  EXPECT_NE(along.fine_energy, tight.fine_energy);
 }
 
 // The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) is refused
