@@ -144,25 +144,24 @@ void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
 }
 
 // The coarse stage's first label at the pixels of pyramid level `level` (width x height) when
-// its labels start at the visual hull: the label of the hull's entry less `tolerance` (the
-// depth bound) at the level pixel's NearestLevel0Pixel; 0 where the ray misses
-// the hull. At most the label from which num_labels labels end at 10 x depth_max, only so
-// that the band's depths stay finite in inverse depth (labels past the range's far end cost
-// time, not accuracy: an estimate there is filtered as outside the range).
-std::vector<float> VisualHullLabelBase(const FloatMap& visual_hull_entry, double tolerance,
-                                       const DepthLabels& labels, int level, int width,
-                                       int height) {
+// its labels start at the visual hull: the depth bound's label (`bound_labels0`, level-0 grid
+// width0 x height0, -inf = none) at the level pixel's NearestLevel0Pixel; 0 where there is
+// none. At most the label from which num_labels labels end at 10 x depth_max, only so that the
+// band's depths stay finite in inverse depth (labels past the range's far end cost time, not
+// accuracy: an estimate there is filtered as outside the range).
+std::vector<float> VisualHullLabelBase(const std::vector<float>& bound_labels0, int width0,
+                                       int height0, const DepthLabels& labels, int level,
+                                       int width, int height) {
   const float top = static_cast<float>(
       std::max(0.0, labels.Label(10 * labels.depth_max) - (labels.num_labels - 1)));
   std::vector<float> base(static_cast<size_t>(width) * height, 0.0f);
   for (int r = 0; r < height; ++r) {
-    const int r0 = NearestLevel0Pixel(r, level, visual_hull_entry.Height());
+    const int r0 = NearestLevel0Pixel(r, level, height0);
     for (int c = 0; c < width; ++c) {
-      const int c0 = NearestLevel0Pixel(c, level, visual_hull_entry.Width());
-      const double bound = visual_hull_entry.At(r0, c0) - tolerance;
-      if (visual_hull_entry.At(r0, c0) > 0 && bound > 0) {
-        base[static_cast<size_t>(r) * width + c] =
-            std::clamp(static_cast<float>(labels.Label(bound)), 0.0f, top);
+      const float bound = bound_labels0[static_cast<size_t>(r0) * width0 +
+                                        NearestLevel0Pixel(c, level, width0)];
+      if (std::isfinite(bound)) {
+        base[static_cast<size_t>(r) * width + c] = std::clamp(bound, 0.0f, top);
       }
     }
   }
@@ -435,6 +434,22 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const int coarse_level = two_stage ? std::min(options.coarse_level, num_levels - 1) : 0;
   const int coarse_first_level = two_stage ? options.coarse_first_level : 0;
 
+  // The visual hull's depth bound (its entry less the tolerance) as labels on the level-0 grid
+  // (-inf = none): where the coarse labels start, and, per visual_hull_depth_bound, a bound.
+  std::vector<float> bound0;
+  if (!visual_hull_entry.Empty()) {
+    bound0.assign(static_cast<size_t>(width0) * height0, -std::numeric_limits<float>::infinity());
+    for (size_t p = 0; p < bound0.size(); ++p) {
+      const float entry = visual_hull_entry.Data()[p];
+      const double d = entry - options.visual_hull_tolerance_m;
+      if (entry > 0 && d > 0) bound0[p] = static_cast<float>(labels.Label(d));
+    }
+  }
+  const bool penalize =
+      options.visual_hull_depth_bound == VisualHullBound::kPenalty && !bound0.empty();
+  const bool filter_by_bound =
+      options.visual_hull_depth_bound == VisualHullBound::kFilter && !bound0.empty();
+
   // Coarse stage: every label, on the coarse grid; from the visual hull's bound on with
   // coarse_labels_from_visual_hull.
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
@@ -443,8 +458,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   std::vector<std::vector<float>> coarse_base(num_levels);
   for (int l = 0; l < num_levels; ++l) {
     coarse_base[l] = coarse_from_hull
-                         ? VisualHullLabelBase(visual_hull_entry, options.visual_hull_tolerance_m,
-                                               labels, l, levels[l].width, levels[l].height)
+                         ? VisualHullLabelBase(bound0, width0, height0, labels, l,
+                                               levels[l].width, levels[l].height)
                          : std::vector<float>(
                                static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);
   }
@@ -475,19 +490,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                       LevelPixelsPerPixel(0, coarse_level), labels, coarse_grid_base, 1.0f,
                       num_depths, prior_scale, &coarse_volume);
   }
-  // The depth lower bound (the hull's entry less the tolerance) as labels on the level-0 grid
-  // (-inf = none).
-  std::vector<float> bound0;
-  if (!visual_hull_entry.Empty() && options.visual_hull_depth_bound != VisualHullBound::kOff) {
-    const float tolerance = static_cast<float>(options.visual_hull_tolerance_m);
-    bound0.assign(static_cast<size_t>(width0) * height0, -std::numeric_limits<float>::infinity());
-    for (size_t p = 0; p < bound0.size(); ++p) {
-      const float entry = visual_hull_entry.Data()[p], d = entry - tolerance;
-      if (entry > 0 && d > 0) bound0[p] = static_cast<float>(labels.Label(d));
-    }
-  }
-  const bool penalize = options.visual_hull_depth_bound == VisualHullBound::kPenalty;
-  if (penalize && !bound0.empty()) {
+  if (penalize) {
     // On the coarse grid, the smallest bound of each block, so that it never excludes what a
     // finer pixel allows.
     const int factor = 1 << coarse_level;
@@ -563,7 +566,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
       AddGeometricPrior(*prior, ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step,
                         band, prior_scale, &fine_volume);
     }
-    if (penalize && !bound0.empty()) {
+    if (penalize) {
       PenalizeInFrontOfBound(bound0, base[0], step, band, &fine_volume);
     }
     if (progress != nullptr) progress->Stage("MRF (fine band)");
@@ -601,7 +604,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     const float v = value.Data()[p];
     bool valid = mask0.Data()[p] > 0.5f && depth.Data()[p] > 0;
     if (options.filter_range_ends && (v < 0.5f || v > num_depths - 1.5f)) valid = false;
-    if (!penalize && !bound0.empty() && v < bound0[p]) valid = false;
+    if (filter_by_bound && v < bound0[p]) valid = false;
     if (estimate.confidence.Data()[p] < options.min_confidence) valid = false;
     if (!valid) depth.Data()[p] = 0.0f;
     if (valid) ++estimate.num_valid;
