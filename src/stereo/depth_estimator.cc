@@ -79,7 +79,8 @@ namespace {
 
 // Per-level machinery of one reference view.
 struct LevelPipeline {
-  std::unique_ptr<CostVolumeCL> cost;
+  // The data term's costs and their weights (one, or orientation then colour when combined).
+  std::vector<std::pair<std::unique_ptr<CostVolumeCL>, float>> costs;
   std::unique_ptr<GuidedFilterCL> filter;
   int width = 0;
   int height = 0;
@@ -297,13 +298,13 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                std::vector<float>* coarse_volume_cache) {
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
   THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
-  const bool photometric = options.cost == StereoCost::kPhotometric;
+  const bool colour = options.MatchesColour();
   int num_levels = std::min<int>(options.num_levels, static_cast<int>(ref.orientation.size()));
   for (const StereoViewData* src : sources) {
     num_levels = std::min<int>(num_levels, static_cast<int>(src->orientation.size()));
-    if (photometric) num_levels = std::min<int>(num_levels, static_cast<int>(src->rgb.size()));
+    if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(src->rgb.size()));
   }
-  if (photometric) num_levels = std::min<int>(num_levels, static_cast<int>(ref.rgb.size()));
+  if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(ref.rgb.size()));
   THROW_IF(num_levels < 1, "EstimateDepthMap: no common pyramid level");
   const int width0 = ref.orientation[0].Width();
   const int height0 = ref.orientation[0].Height();
@@ -327,25 +328,40 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
+    // (cost, its weight): orientation, colour, or both.
+    std::vector<std::pair<StereoCost, float>> terms;
+    if (options.MatchesOrientation()) {
+      terms.emplace_back(StereoCost::kOrientation,
+                         colour ? static_cast<float>(1 - options.photometric_weight) : 1.0f);
+    }
+    if (colour) {
+      terms.emplace_back(StereoCost::kPhotometric,
+                         options.MatchesOrientation()
+                             ? static_cast<float>(options.photometric_weight) : 1.0f);
+    }
     for (int l = 0; l < num_levels; ++l) {
-      auto matched = [photometric, l](const StereoViewData& view) -> const FloatMap& {
-        if (photometric) return view.rgb[l];
-        return view.matching.empty() ? view.orientation[l] : view.matching[l];
-      };
-      // Level cameras as the pyramid makes the levels (CostVolumeCL checks their sizes).
-      CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref)};
-      if (strand_plane_from_hull) {
-        ref_in.log_depth_gradient = LogDepthGradient(
-            visual_hull_entry, l, ref_in.field.Width(), ref_in.field.Height(),
-            ref.camera.K(0, 0), options.max_strand_plane_tilt_deg);
+      for (const auto& [cost, weight] : terms) {
+        auto matched = [cost = cost, l](const StereoViewData& view) -> const FloatMap& {
+          if (cost == StereoCost::kPhotometric) return view.rgb[l];
+          return view.matching.empty() ? view.orientation[l] : view.matching[l];
+        };
+        // Level cameras as the pyramid makes the levels (CostVolumeCL checks their sizes).
+        CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref)};
+        if (strand_plane_from_hull && cost == StereoCost::kOrientation) {
+          ref_in.log_depth_gradient = LogDepthGradient(
+              visual_hull_entry, l, ref_in.field.Width(), ref_in.field.Height(),
+              ref.camera.K(0, 0), options.max_strand_plane_tilt_deg);
+        }
+        std::vector<CostViewInput> src_in;
+        for (const StereoViewData* src : sources) {
+          src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
+        }
+        levels[l].costs.emplace_back(
+            std::make_unique<CostVolumeCL>(context, cost, ref_in, src_in,
+                                           options.orientation_transfer,
+                                           options.ncc_window_px / 2),
+            weight);
       }
-      std::vector<CostViewInput> src_in;
-      for (const StereoViewData* src : sources) {
-        src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
-      }
-      levels[l].cost = std::make_unique<CostVolumeCL>(context, options.cost, ref_in, src_in,
-                                                      options.orientation_transfer,
-                                                      options.ncc_window_px / 2);
       levels[l].width = ref.orientation[l].Width();
       levels[l].height = ref.orientation[l].Height();
     }
@@ -390,16 +406,20 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     for (int s0 = 0; s0 < num_labels; s0 += block) {
       const int ns = std::min(block, num_labels - s0);
       for (int l = first_level; l < num_levels; ++l) {
-        {
-          ScopedStageTimer timer(timings, "cost volume");
-          levels[l].cost->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
+        // The guided filter is linear: each cost is aggregated and added with its weight.
+        for (const auto& [cost, weight] : levels[l].costs) {
+          {
+            ScopedStageTimer timer(timings, "cost volume");
+            cost->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
+            queue.finish();
+          }
+          ScopedStageTimer timer(timings, "aggregation");
+          levels[l].filter->Filter(blocks[l], ns, blocks[l]);
+          resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0,
+                       level_weight * weight,
+                       static_cast<float>(LevelPixelsPerPixel(l, grid_level)));
           queue.finish();
         }
-        ScopedStageTimer timer(timings, "aggregation");
-        levels[l].filter->Filter(blocks[l], ns, blocks[l]);
-        resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0,
-                     level_weight, static_cast<float>(LevelPixelsPerPixel(l, grid_level)));
-        queue.finish();
       }
     }
     queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());

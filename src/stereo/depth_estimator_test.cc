@@ -49,7 +49,17 @@ struct Result {
   double median_abs_error_m = 0;
   double completeness = 0;
   double fine_energy = 0;  // the fine stage's MRF energy
+  FloatMap coarse_data_term;  // with options.write_cost_volume
 };
+
+// The rendered grey picture as the 3-channel colour image the photometric cost matches.
+FloatMap GreyToRgb(const FloatMap& gray) {
+  FloatMap rgb(gray.Width(), gray.Height(), 3);
+  for (int c = 0; c < 3; ++c) {
+    std::copy(gray.Data().begin(), gray.Data().end(), rgb.Channel(c));
+  }
+  return rgb;
+}
 
 // Renders the views, estimates the reference's depth map, compares with the truth on pixels
 // where the truth exists.
@@ -64,7 +74,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   for (const StereoCamera& camera : cameras) {
     const testing_util::RenderedView view = RenderView(camera, surface, strands);
     if (true_depth.Empty()) true_depth = view.depth;
-    views.push_back({camera, Pyramid(view.orientation, 3), {}, {}});
+    views.push_back({camera, Pyramid(view.orientation, 3), {}, Pyramid(GreyToRgb(view.gray), 3)});
   }
   std::vector<const StereoViewData*> sources;
   for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
@@ -96,6 +106,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   }
   result.completeness = truth > 0 ? static_cast<double>(errors.size()) / truth : 0;
   result.fine_energy = estimate.fine_energy;
+  result.coarse_data_term = estimate.coarse_data_term.cost;
   return result;
 }
 
@@ -240,12 +251,54 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   options = OrientationStereoOptions();
   options.cost = StereoCost::kPhotometric;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
+  options.cost = StereoCost::kCombined;
+  EXPECT_TRUE(options.StrandPlaneFromVisualHull());
+  for (double weight : {-0.1, 1.1}) {
+    options.photometric_weight = weight;
+    error.clear();
+    EXPECT_FALSE(options.Check(&error));
+    EXPECT_NE(error.find("photometric_weight"), std::string::npos) << error;
+  }
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
   options = OrientationStereoOptions();
   options.strand_plane_from_visual_hull = false;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
+}
+
+// The combined cost's data term is the weighted sum of the orientation and photometric costs'
+// (each aggregated alike), and it recovers the tilted plane as each of them does.
+TEST(DepthEstimator, CombinedCostIsTheWeightedSumOfTheTwoCosts) {
+  OrientationStereoOptions options = TestOptions();
+  options.write_cost_volume = true;
+  const Result orientation = ReconstructTiltedPlane(options);
+  options.cost = StereoCost::kPhotometric;
+  const Result photometric = ReconstructTiltedPlane(options);
+  options.cost = StereoCost::kCombined;
+  options.photometric_weight = 0.3;
+  const Result combined = ReconstructTiltedPlane(options);
+  std::printf("tilted plane: median |error| orientation %.4f, photometric %.4f, combined %.4f m\n",
+              orientation.median_abs_error_m, photometric.median_abs_error_m,
+              combined.median_abs_error_m);
+  const std::vector<float>& o = orientation.coarse_data_term.Data();
+  const std::vector<float>& p = photometric.coarse_data_term.Data();
+  const std::vector<float>& c = combined.coarse_data_term.Data();
+  ASSERT_FALSE(c.empty());
+  ASSERT_EQ(c.size(), o.size());
+  ASSERT_EQ(c.size(), p.size());
+  double max_difference = 0, max_cost = 0;
+  for (size_t i = 0; i < c.size(); ++i) {
+    max_difference = std::max(max_difference, std::abs(c[i] - (0.7 * o[i] + 0.3 * p[i])));
+    max_cost = std::max({max_cost, std::abs(static_cast<double>(o[i])),
+                         std::abs(static_cast<double>(p[i]))});
+  }
+  EXPECT_GT(max_cost, 0.1);
+  EXPECT_LT(max_difference, 1e-4 * max_cost);
+  for (const Result* result : {&orientation, &photometric, &combined}) {
+    EXPECT_LT(result->median_abs_error_m, 0.015);
+    EXPECT_GT(result->completeness, 0.8);
+  }
 }
 
 // A rolled source: the reference's orientations must be carried into it, by the paper's epipole

@@ -65,7 +65,9 @@ struct FirstEstimate {
 namespace {
 
 constexpr std::pair<StereoCost, const char*> kStereoCostNames[] = {
-    {StereoCost::kOrientation, "orientation"}, {StereoCost::kPhotometric, "photometric"}};
+    {StereoCost::kOrientation, "orientation"},
+    {StereoCost::kPhotometric, "photometric"},
+    {StereoCost::kCombined, "combined"}};
 constexpr std::pair<DepthSampling, const char*> kDepthSamplingNames[] = {
     {DepthSampling::kDepth, "depth"}, {DepthSampling::kInverseDepth, "inverse_depth"}};
 constexpr std::pair<OrientationTransfer, const char*> kOrientationTransferNames[] = {
@@ -99,7 +101,7 @@ bool FromString(const std::string& text, VisualHullBound* bound) {
 }
 
 bool OrientationStereoOptions::StrandPlaneFromVisualHull() const {
-  return strand_plane_from_visual_hull && cost == StereoCost::kOrientation &&
+  return strand_plane_from_visual_hull && MatchesOrientation() &&
          orientation_transfer == OrientationTransfer::kPlaneHomography;
 }
 
@@ -148,6 +150,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(fine_label_step > 0)) e << "fine_label_step must be > 0; ";
   if (slice_block < 1) e << "slice_block must be >= 1; ";
   if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
+  if (!(photometric_weight >= 0 && photometric_weight <= 1)) {
+    e << "photometric_weight must be in [0, 1]; ";
+  }
   *error = e.str();
   return error->empty();
 }
@@ -344,15 +349,14 @@ class ViewLoader {
         }
       }
     }
-    if (options_.cost == StereoCost::kOrientation &&
-        options_.orientation_normalization_radius_px > 0) {
+    if (options_.MatchesOrientation() && options_.orientation_normalization_radius_px > 0) {
       for (const FloatMap& level : data.orientation) {
         data.matching.push_back(NormalizeOrientationField(
             level, options_.orientation_normalization_radius_px,
             static_cast<float>(options_.orientation_normalization_eps)));
       }
     }
-    if (options_.cost == StereoCost::kPhotometric) {
+    if (options_.MatchesColour()) {
       data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
       for (int l = 1; l < options_.num_levels; ++l) {
         data.rgb.push_back(DownsampleHalf(data.rgb.back()));
