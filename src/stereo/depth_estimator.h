@@ -25,7 +25,7 @@ struct StereoViewData {
   // local normalisation (NormalizeOrientationField). Empty = `orientation`. The guide of the
   // aggregation and the smoothness weights always use `orientation`.
   std::vector<FloatMap> matching;
-  std::vector<FloatMap> rgb;           // per level, 3 channels (photometric cost only)
+  std::vector<FloatMap> rgb;           // per level, 3 channels (costs that match colours)
 };
 
 // Local normalisation of an orientation field for matching: (O - mean_w(O)) / sqrt(mean_w(|O -
