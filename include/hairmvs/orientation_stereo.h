@@ -227,9 +227,10 @@ struct OrientationStereoOptions {
   // weigh them alike). Measured (equal shares, against the orientation cost alone): the data
   // term alone, median error of its best label, synth_handheld 16.34 -> 10.47 mm (photometric
   // alone 12.31), synth_straight_gantry 4.89 -> 4.35 mm, the curly demo group 5.32 -> 3.05 mm;
-  // the .geometric maps' median 5.85 -> 5.30, 4.55 -> 4.32, 2.35 -> 2.24 mm. About 4 x the
-  // time (a 1404 x 936 T group: 62 -> 263 s): the colour cost reads every pixel, the
-  // orientation cost only the masks' hair. Hence not the default.
+  // the .geometric maps' median 5.85 -> 5.30 (both with 4 source views: with 6, the default,
+  // colour matching loses on the handheld's wider pairs: 5.75 -> 5.67 mm), 4.55 -> 4.32,
+  // 2.35 -> 2.24 mm. About 4 x the time (a 1404 x 936 T group: 62 -> 263 s): the colour cost
+  // reads every pixel, the orientation cost only the masks' hair. Hence not the default.
   double photometric_weight = 0.5;
   // Geometric consistency, as COLMAP's patch_match_stereo names its passes: each view's depth
   // map as first estimated is written as depth_maps/<name>.photometric.bin. The geometric pass
