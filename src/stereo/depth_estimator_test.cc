@@ -234,9 +234,16 @@ TEST(DepthEstimator, CoarseLabelsFromTheVisualHullFollowTheSphere) {
   EXPECT_NE(along.fine_energy, tight.fine_energy);
 }
 
-// The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) is refused
-// by name. The strands' plane follows the hull only for the orientation cost's plane
-// homography.
+// Check() refuses `options`, naming `option` in its message.
+void ExpectRefusedNaming(const OrientationStereoOptions& options, const std::string& option) {
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find(option), std::string::npos) << error;
+}
+
+// The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) and a
+// photometric weight outside [0, 1] are refused by name. The strands' plane follows the hull
+// only for the costs that match orientations, through the plane homography.
 TEST(OrientationStereoOptions, StrandPlaneOptions) {
   OrientationStereoOptions options;
   std::string error;
@@ -244,9 +251,7 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   EXPECT_TRUE(options.StrandPlaneFromVisualHull());
   for (double tilt : {90.0, -1.0}) {
     options.max_strand_plane_tilt_deg = tilt;
-    error.clear();
-    EXPECT_FALSE(options.Check(&error));
-    EXPECT_NE(error.find("max_strand_plane_tilt_deg"), std::string::npos) << error;
+    ExpectRefusedNaming(options, "max_strand_plane_tilt_deg");
   }
   options = OrientationStereoOptions();
   options.cost = StereoCost::kPhotometric;
@@ -255,9 +260,7 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   EXPECT_TRUE(options.StrandPlaneFromVisualHull());
   for (double weight : {-0.1, 1.1}) {
     options.photometric_weight = weight;
-    error.clear();
-    EXPECT_FALSE(options.Check(&error));
-    EXPECT_NE(error.find("photometric_weight"), std::string::npos) << error;
+    ExpectRefusedNaming(options, "photometric_weight");
   }
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
