@@ -488,9 +488,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const size_t coarse_size = static_cast<size_t>(cw) * ch * num_depths;
   std::vector<float> coarse_volume;
   if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
-    // Moved out, not copied: the geometric pass is the volume's last use.
-    coarse_volume = std::move(*coarse_volume_cache);
-    coarse_volume_cache->clear();
+    // Copied: each round of the geometric pass uses it (the caller frees it after the last).
+    coarse_volume = *coarse_volume_cache;
   } else {
     coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
                                  num_depths, coarse_base, 1.0f);

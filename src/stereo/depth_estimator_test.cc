@@ -242,7 +242,8 @@ void ExpectRefusedNaming(const OrientationStereoOptions& options, const std::str
 }
 
 // The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) and a
-// photometric weight outside [0, 1] are refused by name. The strands' plane follows the hull
+// photometric weight outside [0, 1] and fewer than one round of the geometric pass are refused
+// by name. The strands' plane follows the hull
 // only for the costs that match orientations, through the plane homography.
 TEST(OrientationStereoOptions, StrandPlaneOptions) {
   OrientationStereoOptions options;
@@ -262,6 +263,9 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
     options.photometric_weight = weight;
     ExpectRefusedNaming(options, "photometric_weight");
   }
+  options = OrientationStereoOptions();
+  options.geom_consistency_iterations = 0;
+  ExpectRefusedNaming(options, "geom_consistency_iterations");
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());

@@ -123,6 +123,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
   if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
   if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
+  if (geom_consistency_iterations < 1) e << "geom_consistency_iterations must be >= 1; ";
   if (coarse_volume_cache_mib < 0) e << "coarse_volume_cache_mib must be >= 0; ";
   if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
   if (geom_consistency_only && !geom_consistency) {
@@ -567,14 +568,20 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
   if (options.geom_consistency) {
     // The geometric pass: every view estimated now (or, with geom_consistency_only, every
-    // requested view), estimated again with its sources' .photometric maps as a prior and
-    // filtered by consistency with them.
+    // requested view) is estimated again with its sources' maps as a prior, in
+    // geom_consistency_iterations rounds (each from the previous round's maps of every view,
+    // the .photometric ones first, so that the order of the views does not matter), and its
+    // final map filtered by consistency with the maps its prior came from (as COLMAP's
+    // geometric pass filters against the maps it reads: with one round, a job of an array
+    // gives the map one process would).
     const std::vector<std::string>& to_filter = options.geom_consistency_only ? names : estimated;
-    Progress filter_progress("geometric consistency", static_cast<int>(to_filter.size()));
-    std::map<std::string, FusionView> photometric;  // read once each
+    // Each view's latest map but the last round's: its .photometric map (read once), then
+    // each round's estimate.
+    std::map<std::string, FusionView> latest;
+    std::map<std::string, FusionView> final_maps;  // the last round's estimates
     auto load = [&](const std::string& name) -> const FusionView* {
-      auto it = photometric.find(name);
-      if (it == photometric.end()) {
+      auto it = latest.find(name);
+      if (it == latest.end()) {
         FusionView view;
         const std::string path = workspace.DepthMapPath(name, "photometric");
         if (ExistsFile(path)) {
@@ -587,56 +594,92 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           view.R = camera.R;
           view.t = camera.t;
         }
-        it = photometric.emplace(name, std::move(view)).first;
+        it = latest.emplace(name, std::move(view)).first;
       }
       return it->second.depth.Empty() ? nullptr : &it->second;
     };
-    for (size_t i = 0; i < to_filter.size(); ++i) {
-      const std::string& name = to_filter[i];
-      filter_progress.Start(static_cast<int>(i), name);
+    // The reference's latest map and those of its sources that have one.
+    auto load_with_sources = [&](const std::string& name, std::vector<const FusionView*>* others,
+                                 size_t* num_sources) -> const FusionView* {
       const FusionView* ref = load(name);
       THROW_IF(ref == nullptr, workspace.DepthMapPath(name, "photometric")
                                    << ": missing; run orientation_stereo on " << name
                                    << " first (without geom_consistency_only)");
-      std::vector<const FusionView*> others;
-      size_t num_sources = 0;
+      others->clear();
+      *num_sources = 0;
       const auto it = sources_of.find(name);
       if (it != sources_of.end()) {
-        num_sources = it->second.size();
+        *num_sources = it->second.size();
         for (const std::string& source : it->second) {
-          if (const FusionView* view = load(source)) others.push_back(view);
+          if (const FusionView* view = load(source)) others->push_back(view);
         }
       }
-      FusionView estimate = *ref;
+      return ref;
+    };
+    const int rounds = options.geom_prior_weight > 0 ? options.geom_consistency_iterations : 0;
+    for (int round = 0; round < rounds; ++round) {
+      const bool last_round = round + 1 == rounds;
+      std::ostringstream task;
+      task << "geometric consistency";
+      if (rounds > 1) task << ", round " << round + 1 << " of " << rounds;
+      Progress round_progress(task.str(), static_cast<int>(to_filter.size()));
+      std::map<std::string, FusionView> next;
+      for (size_t i = 0; i < to_filter.size(); ++i) {
+        const std::string& name = to_filter[i];
+        round_progress.Start(static_cast<int>(i), name);
+        std::vector<const FusionView*> others;
+        size_t num_sources = 0;
+        const FusionView* ref = load_with_sources(name, &others, &num_sources);
+        // Without all of its sources' maps (a job array's other jobs), the prior would depend
+        // on which are done: such a view is only filtered (the filter below says so).
+        if (others.empty() || others.size() < num_sources) continue;
+        // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
+        GeometricPrior prior;
+        prior.views = others;
+        prior.weight = options.geom_prior_weight;
+        prior.max_error_px = options.geom_prior_max_error_px;
+        const auto cached = first_estimates.find(name);
+        FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
+        if (std::optional<ViewEstimate> view =
+                estimate_view(name, &round_progress, &prior, cache)) {
+          FusionView estimate = *ref;
+          estimate.depth = std::move(view->estimate.depth);
+          estimate.K = view->K;
+          next.emplace(name, std::move(estimate));
+          // The confidence of the map that is written as .geometric.
+          if (last_round) WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
+        }
+        if (last_round) first_estimates.erase(name);
+      }
+      round_progress.Finish();
+      if (last_round) {
+        final_maps = std::move(next);
+      } else {
+        for (auto& [name, view] : next) latest[name] = std::move(view);
+      }
+    }
+    first_estimates.clear();
+
+    Progress filter_progress("consistency filter", static_cast<int>(to_filter.size()));
+    for (size_t i = 0; i < to_filter.size(); ++i) {
+      const std::string& name = to_filter[i];
+      filter_progress.Start(static_cast<int>(i), name);
+      std::vector<const FusionView*> others;
+      size_t num_sources = 0;
+      const FusionView* ref = load_with_sources(name, &others, &num_sources);
+      const auto estimated_again = final_maps.find(name);
+      FusionView estimate = estimated_again != final_maps.end() ? estimated_again->second : *ref;
       if (others.empty()) {
         LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
       } else {
-        if (options.geom_prior_weight > 0 && others.size() < num_sources) {
-          // A job of an array whose neighbours are not done: the prior would depend on which.
+        if (rounds > 0 && others.size() < num_sources) {
           LOG(WARNING) << name << ": " << others.size() << " of its " << num_sources
                        << " source views have a .photometric depth map yet; its .geometric map "
                        << "is only filtered (run again with "
                        << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
-        } else if (options.geom_prior_weight > 0) {
-          // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
-          GeometricPrior prior;
-          prior.views = others;
-          prior.weight = options.geom_prior_weight;
-          prior.max_error_px = options.geom_prior_max_error_px;
-          const auto cached = first_estimates.find(name);
-          FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
-          if (std::optional<ViewEstimate> view =
-                  estimate_view(name, &filter_progress, &prior, cache)) {
-            estimate.depth = std::move(view->estimate.depth);
-            estimate.K = view->K;
-            // The confidence of the map that is written as .geometric.
-            WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
-          }
         }
-        first_estimates.erase(name);
-        filter_progress.Stage("consistency filter");
         ScopedStageTimer timer(timings, "consistency");
         ConsistencyFilterStats stats;
         estimate.depth = FilterDepthMapByConsistency(estimate, others,

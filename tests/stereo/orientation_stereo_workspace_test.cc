@@ -313,5 +313,62 @@ TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAs
   std::filesystem::remove_all(path);
 }
 
+// Two rounds of the geometric pass are one round run twice: the second estimates every view
+// again with the first round's maps as the prior and filters against them, exactly as a
+// geometric pass alone would whose .photometric maps were the first round's (unfiltered).
+TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilter) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "hairmvs_stereo_rounds_test").string();
+  std::filesystem::remove_all(path);
+  const std::vector<FloatMap> true_depths = WriteWorkspace(path);
+  const std::vector<std::string> names = {"v0.png", "v1.png", "v2.png", "v3.png"};
+  const Workspace workspace = Workspace::Read(path);
+  auto read_geometric = [&]() {
+    std::vector<FloatMap> maps;
+    for (const std::string& name : names) {
+      maps.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
+    }
+    return maps;
+  };
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_consistency_iterations = 2;
+  StageTimings timings;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  const std::vector<FloatMap> two_rounds = read_geometric();
+
+  // One round, unfiltered (no view needs to agree).
+  options.geom_consistency_iterations = 1;
+  options.geom_consistency_min_views = 0;
+  RunOrientationStereo(path, {}, options, &timings);
+  const std::vector<FloatMap> first_round = read_geometric();
+  // ... as the .photometric maps of a geometric pass alone, filtered as by default.
+  for (size_t v = 0; v < names.size(); ++v) {
+    WriteMat(workspace.DepthMapPath(names[v], "photometric"), first_round[v]);
+  }
+  options.geom_consistency_min_views = OrientationStereoOptions().geom_consistency_min_views;
+  options.geom_consistency_only = true;
+  RunOrientationStereo(path, names, options, &timings);
+  const std::vector<FloatMap> round_again = read_geometric();
+
+  size_t changed_by_second_round = 0;
+  for (size_t v = 0; v < names.size(); ++v) {
+    EXPECT_EQ(two_rounds[v].Data(), round_again[v].Data()) << names[v];
+    std::vector<double> errors;
+    for (size_t p = 0; p < two_rounds[v].NumPixels(); ++p) {
+      const float d = two_rounds[v].Data()[p], truth = true_depths[v].Data()[p];
+      const float first = first_round[v].Data()[p];
+      changed_by_second_round += d > 0 && first > 0 && d != first;
+      if (d > 0 && truth > 0) errors.push_back(std::abs(d - truth));
+    }
+    ASSERT_GT(errors.size(), two_rounds[v].NumPixels() / 2) << names[v];
+    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+    std::printf("%s: two rounds: %zu depths, median |error| %.4f m\n", names[v].c_str(),
+                errors.size(), errors[errors.size() / 2]);
+    EXPECT_LT(errors[errors.size() / 2], 0.02) << names[v];  // as one round (tests above)
+  }
+  EXPECT_GT(changed_by_second_round, 0u);  // the second round estimated the views again
+  std::filesystem::remove_all(path);
+}
+
 }  // namespace
 }  // namespace hairmvs
