@@ -598,23 +598,26 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       return it->second.depth.Empty() ? nullptr : &it->second;
     };
-    // The reference's latest map and those of its sources that have one.
-    auto load_with_sources = [&](const std::string& name, std::vector<const FusionView*>* others,
-                                 size_t* num_sources) -> const FusionView* {
-      const FusionView* ref = load(name);
-      THROW_IF(ref == nullptr, workspace.DepthMapPath(name, "photometric")
-                                   << ": missing; run orientation_stereo on " << name
-                                   << " first (without geom_consistency_only)");
-      others->clear();
-      *num_sources = 0;
+    // A view's latest map and those of its sources that have one (of num_sources).
+    struct ViewMaps {
+      const FusionView* ref = nullptr;
+      std::vector<const FusionView*> sources;
+      size_t num_sources = 0;
+    };
+    auto maps_of = [&](const std::string& name) {
+      ViewMaps maps;
+      maps.ref = load(name);
+      THROW_IF(maps.ref == nullptr, workspace.DepthMapPath(name, "photometric")
+                                        << ": missing; run orientation_stereo on " << name
+                                        << " first (without geom_consistency_only)");
       const auto it = sources_of.find(name);
       if (it != sources_of.end()) {
-        *num_sources = it->second.size();
+        maps.num_sources = it->second.size();
         for (const std::string& source : it->second) {
-          if (const FusionView* view = load(source)) others->push_back(view);
+          if (const FusionView* view = load(source)) maps.sources.push_back(view);
         }
       }
-      return ref;
+      return maps;
     };
     const int rounds = options.geom_prior_weight > 0 ? options.geom_consistency_iterations : 0;
     for (int round = 0; round < rounds; ++round) {
@@ -627,22 +630,20 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       for (size_t i = 0; i < to_filter.size(); ++i) {
         const std::string& name = to_filter[i];
         round_progress.Start(static_cast<int>(i), name);
-        std::vector<const FusionView*> others;
-        size_t num_sources = 0;
-        const FusionView* ref = load_with_sources(name, &others, &num_sources);
+        const ViewMaps maps = maps_of(name);
         // Without all of its sources' maps (a job array's other jobs), the prior would depend
         // on which are done: such a view is only filtered (the filter below says so).
-        if (others.empty() || others.size() < num_sources) continue;
+        if (maps.sources.empty() || maps.sources.size() < maps.num_sources) continue;
         // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
         GeometricPrior prior;
-        prior.views = others;
+        prior.views = maps.sources;
         prior.weight = options.geom_prior_weight;
         prior.max_error_px = options.geom_prior_max_error_px;
         const auto cached = first_estimates.find(name);
         FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
         if (std::optional<ViewEstimate> view =
                 estimate_view(name, &round_progress, &prior, cache)) {
-          FusionView estimate = *ref;
+          FusionView estimate = *maps.ref;
           estimate.depth = std::move(view->estimate.depth);
           estimate.K = view->K;
           next.emplace(name, std::move(estimate));
@@ -664,18 +665,18 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     for (size_t i = 0; i < to_filter.size(); ++i) {
       const std::string& name = to_filter[i];
       filter_progress.Start(static_cast<int>(i), name);
-      std::vector<const FusionView*> others;
-      size_t num_sources = 0;
-      const FusionView* ref = load_with_sources(name, &others, &num_sources);
+      const ViewMaps maps = maps_of(name);
+      const std::vector<const FusionView*>& others = maps.sources;
       const auto estimated_again = final_maps.find(name);
-      FusionView estimate = estimated_again != final_maps.end() ? estimated_again->second : *ref;
+      FusionView estimate =
+          estimated_again != final_maps.end() ? estimated_again->second : *maps.ref;
       if (others.empty()) {
         LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
       } else {
-        if (rounds > 0 && others.size() < num_sources) {
-          LOG(WARNING) << name << ": " << others.size() << " of its " << num_sources
+        if (rounds > 0 && others.size() < maps.num_sources) {
+          LOG(WARNING) << name << ": " << others.size() << " of its " << maps.num_sources
                        << " source views have a .photometric depth map yet; its .geometric map "
                        << "is only filtered (run again with "
                        << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
