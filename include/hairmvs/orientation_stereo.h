@@ -13,6 +13,7 @@
 // pictures of depths and normals.
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "src/core/timer.h"
@@ -387,6 +388,9 @@ struct OrientationStereoOptions {
   bool MatchesOrientation() const { return cost != StereoCost::kPhotometric; }
   // Whether the data term matches colours (photometric or combined cost).
   bool MatchesColour() const { return cost != StereoCost::kOrientation; }
+  // The single costs the data term sums, each with its weight: the cost itself with 1, or for
+  // the combined cost orientation with 1 - photometric_weight and colour with photometric_weight.
+  std::vector<std::pair<StereoCost, float>> DataTerms() const;
   // Whether the orientation cost carries strands through planes tilted as the visual hull
   // (strand_plane_from_visual_hull with an orientation-matching cost and plane_homography).
   bool StrandPlaneFromVisualHull() const;

@@ -328,17 +328,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   std::vector<LevelPipeline> levels(num_levels);
   {
     ScopedStageTimer timer(timings, "cost volume");
-    // (cost, its weight): orientation, colour, or both.
-    std::vector<std::pair<StereoCost, float>> terms;
-    if (options.MatchesOrientation()) {
-      terms.emplace_back(StereoCost::kOrientation,
-                         colour ? static_cast<float>(1 - options.photometric_weight) : 1.0f);
-    }
-    if (colour) {
-      terms.emplace_back(StereoCost::kPhotometric,
-                         options.MatchesOrientation()
-                             ? static_cast<float>(options.photometric_weight) : 1.0f);
-    }
+    const std::vector<std::pair<StereoCost, float>> terms = options.DataTerms();
     for (int l = 0; l < num_levels; ++l) {
       for (const auto& [cost, weight] : terms) {
         auto matched = [cost = cost, l](const StereoViewData& view) -> const FloatMap& {
@@ -488,8 +478,9 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const size_t coarse_size = static_cast<size_t>(cw) * ch * num_depths;
   std::vector<float> coarse_volume;
   if (coarse_volume_cache != nullptr && coarse_volume_cache->size() == coarse_size) {
-    // Copied: each round of the geometric pass uses it (the caller frees it after the last).
-    coarse_volume = *coarse_volume_cache;
+    // Moved out, not copied: the caller passes a copy where it needs the volume again.
+    coarse_volume = std::move(*coarse_volume_cache);
+    coarse_volume_cache->clear();
   } else {
     coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
                                  num_depths, coarse_base, 1.0f);

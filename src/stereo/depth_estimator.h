@@ -72,8 +72,8 @@ void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_cam
                        float cost_scale, std::vector<float>* volume);
 
 // `coarse_volume_cache` (may be null): the coarse stage's aggregated data term, before any
-// prior or bound, which depends only on the views, labels and options; used (copied) when it
-// holds a volume of the coarse grid's size, filled when empty (the geometric pass estimates
+// prior or bound, which depends only on the views, labels and options; used (and emptied) when
+// it holds a volume of the coarse grid's size, filled when empty (the geometric pass estimates
 // each view again from the same data: the all-label volume is most of an estimate's work).
 // `visual_hull_entry` (level-0 grid, metres, 0 = none; may be empty): where each pixel's ray
 // enters the masks' visual hull. Less options.visual_hull_tolerance_m it bounds the depth, per

@@ -13,6 +13,7 @@ namespace {
 
 using testing_util::LookAtCamera;
 using testing_util::MakeStrands;
+using testing_util::MedianAbsError;
 using testing_util::Pyramid;
 using testing_util::RenderView;
 using testing_util::Surface;
@@ -90,21 +91,12 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   }
   const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
                                                   hull_entry, labels, options, nullptr);
-  std::vector<double> errors;
-  int truth = 0;
-  for (size_t p = 0; p < true_depth.Data().size(); ++p) {
-    if (true_depth.Data()[p] <= 0) continue;
-    ++truth;
-    if (estimate.depth.Data()[p] > 0) {
-      errors.push_back(std::abs(estimate.depth.Data()[p] - true_depth.Data()[p]));
-    }
-  }
+  const size_t truth = std::count_if(true_depth.Data().begin(), true_depth.Data().end(),
+                                     [](float d) { return d > 0; });
+  size_t estimated = 0;
   Result result;
-  if (!errors.empty()) {
-    std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-    result.median_abs_error_m = errors[errors.size() / 2];
-  }
-  result.completeness = truth > 0 ? static_cast<double>(errors.size()) / truth : 0;
+  result.median_abs_error_m = MedianAbsError(estimate.depth, true_depth, &estimated);
+  result.completeness = truth > 0 ? static_cast<double>(estimated) / truth : 0;
   result.fine_energy = estimate.fine_energy;
   result.coarse_data_term = estimate.coarse_data_term.cost;
   return result;
@@ -259,6 +251,10 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
   options.cost = StereoCost::kCombined;
   EXPECT_TRUE(options.StrandPlaneFromVisualHull());
+  options.photometric_weight = 0.25;  // the combined data term's two costs and their shares
+  const std::vector<std::pair<StereoCost, float>> terms = {{StereoCost::kOrientation, 0.75f},
+                                                           {StereoCost::kPhotometric, 0.25f}};
+  EXPECT_EQ(options.DataTerms(), terms);
   for (double weight : {-0.1, 1.1}) {
     options.photometric_weight = weight;
     ExpectRefusedNaming(options, "photometric_weight");

@@ -100,6 +100,12 @@ bool FromString(const std::string& text, VisualHullBound* bound) {
   return EnumFromName(kVisualHullBoundNames, text, bound);
 }
 
+std::vector<std::pair<StereoCost, float>> OrientationStereoOptions::DataTerms() const {
+  if (cost != StereoCost::kCombined) return {{cost, 1.0f}};
+  return {{StereoCost::kOrientation, static_cast<float>(1 - photometric_weight)},
+          {StereoCost::kPhotometric, static_cast<float>(photometric_weight)}};
+}
+
 bool OrientationStereoOptions::StrandPlaneFromVisualHull() const {
   return strand_plane_from_visual_hull && MatchesOrientation() &&
          orientation_transfer == OrientationTransfer::kPlaneHomography;
@@ -641,6 +647,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         prior.max_error_px = options.geom_prior_max_error_px;
         const auto cached = first_estimates.find(name);
         FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
+        // The estimate takes the cached volume: a round before the last gets a copy.
+        FirstEstimate copy;
+        if (cache != nullptr && !last_round) {
+          copy = *cache;
+          cache = &copy;
+        }
         if (std::optional<ViewEstimate> view =
                 estimate_view(name, &round_progress, &prior, cache)) {
           FusionView estimate = *maps.ref;

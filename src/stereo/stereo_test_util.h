@@ -5,6 +5,7 @@
 // z-depth of the surface.
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <random>
@@ -226,6 +227,21 @@ inline FloatMap RandomMap(int width, int height, int channels, unsigned seed, fl
   FloatMap map(width, height, channels);
   for (float& v : map.Data()) v = uni(rng);
   return map;
+}
+
+// The median |depth - truth| (m) over the pixels where both are > 0, and how many they are
+// (0 and 0 when none).
+inline double MedianAbsError(const FloatMap& depth, const FloatMap& truth, size_t* count) {
+  std::vector<double> errors;
+  for (size_t p = 0; p < depth.NumPixels(); ++p) {
+    if (depth.Data()[p] > 0 && truth.Data()[p] > 0) {
+      errors.push_back(std::abs(depth.Data()[p] - truth.Data()[p]));
+    }
+  }
+  *count = errors.size();
+  if (errors.empty()) return 0;
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  return errors[errors.size() / 2];
 }
 
 }  // namespace testing_util

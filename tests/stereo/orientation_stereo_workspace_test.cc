@@ -18,6 +18,7 @@
 #include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/file_util.h"
+#include "colmap_ext/test_util.h"
 #include "src/stereo/stereo_test_util.h"
 
 namespace hairmvs {
@@ -25,28 +26,7 @@ namespace {
 
 using namespace testing_util;
 
-// A path for a test's workspace under the temporary folder, emptied.
-std::string FreshPath(const std::string& name) {
-  const std::string path = (std::filesystem::temp_directory_path() / name).string();
-  std::filesystem::remove_all(path);
-  return path;
-}
-
 const std::vector<std::string> kViewNames = {"v0.png", "v1.png", "v2.png", "v3.png"};
-
-// The median |depth - truth| (m) over the pixels where both are > 0, and how many they are.
-double MedianAbsError(const FloatMap& depth, const FloatMap& truth, size_t* count) {
-  std::vector<double> errors;
-  for (size_t p = 0; p < depth.NumPixels(); ++p) {
-    if (depth.Data()[p] > 0 && truth.Data()[p] > 0) {
-      errors.push_back(std::abs(depth.Data()[p] - truth.Data()[p]));
-    }
-  }
-  *count = errors.size();
-  if (errors.empty()) return 0;
-  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  return errors[errors.size() / 2];
-}
 
 // Writes the workspace; returns the true depth map of every view (v0, v1, v2, v3).
 std::vector<FloatMap> WriteWorkspace(const std::string& path) {
@@ -117,7 +97,7 @@ OrientationStereoOptions PlaneOptions() {
 }
 
 TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane) {
-  const std::string path = FreshPath("hairmvs_stereo_workspace_test");
+  const std::string path = MakeTestDir("stereo_workspace");
   const FloatMap true_depth = WriteWorkspace(path)[0];
   OrientationStereoOptions options = PlaneOptions();
   options.write_png = true;
@@ -179,7 +159,7 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
 }
 
 TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
-  const std::string root = FreshPath("hairmvs_stereo_fields_test");
+  const std::string root = MakeTestDir("stereo_fields");
   const std::string stereo_path = JoinPaths(root, "stereo"), fields_path = JoinPaths(root, "f");
   WriteWorkspace(stereo_path);
   WriteWorkspace(fields_path);
@@ -203,7 +183,7 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
 }
 
 TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhotometricPixels) {
-  const std::string path = FreshPath("hairmvs_stereo_consistency_test");
+  const std::string path = MakeTestDir("stereo_consistency");
   const FloatMap true_depth = WriteWorkspace(path)[0];
   OrientationStereoOptions options = PlaneOptions();
   options.geom_prior_weight = 0;  // the filter alone
@@ -252,7 +232,7 @@ TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhoto
 }
 
 TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAsAPrior) {
-  const std::string path = FreshPath("hairmvs_stereo_prior_test");
+  const std::string path = MakeTestDir("stereo_prior");
   const std::vector<FloatMap> true_depths = WriteWorkspace(path);
   const std::vector<std::string>& names = kViewNames;
   OrientationStereoOptions options = PlaneOptions();
@@ -326,7 +306,7 @@ TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAs
 // again with the first round's maps as the prior and filters against them, exactly as a
 // geometric pass alone would whose .photometric maps were the first round's (unfiltered).
 TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilter) {
-  const std::string path = FreshPath("hairmvs_stereo_rounds_test");
+  const std::string path = MakeTestDir("stereo_rounds");
   const std::vector<FloatMap> true_depths = WriteWorkspace(path);
   const std::vector<std::string>& names = kViewNames;
   const Workspace workspace = Workspace::Read(path);
