@@ -261,21 +261,31 @@ struct OrientationStereoOptions {
   // 69.8 s).
   double geom_prior_weight = 1.0;
   double geom_prior_max_error_px = 3.0;
-  // Rounds of the geometric pass (with geom_prior_weight > 0): each round estimates every view
-  // again with its sources' maps of the previous round as the prior (the .photometric maps in
-  // the first), and the last round's maps are filtered by consistency with the maps their prior
-  // came from. A view whose first estimate went wrong (synth_handheld h01: 49 mm behind the
-  // hair, put right by the first round's prior) gives its neighbours a wrong prior in the first
-  // round and a corrected one in the second. Measured (.geometric maps, 1 / 2 / 3 rounds):
-  // synth_handheld (views all around) 80.3 / 84.2 / 84.9% of the hair, per-pixel median 5.75 /
-  // 5.59 / 5.47 mm, mean 11.28 / 10.97 / 10.82, 3D mean 2.13 / 1.84 / 1.82 mm, in 115 / 154 /
-  // 167 s; synth_straight_gantry (T groups) 98.4 / 98.7 / 98.7%, 4.55 mm each, mean 9.70 / 9.88
-  // / 9.91, 3D mean 1.51 / 1.55 / 1.51 mm, in 221 / 273 / 325 s; the curly demo group 2.35 /
-  // 2.36 mm (1 / 2). One round by default: a round costs a third of a first estimate (a 1404 x
-  // 936 T group: 15.5 -> 20.8 s per map) and helps only where views see each other's
-  // mistakes. Later rounds need every view's previous round, which only one process has: a
-  // job of an array takes its other views' .photometric maps in every round.
-  int geom_consistency_iterations = 1;
+  // Rounds of the geometric pass (with geom_prior_weight > 0), at most
+  // geom_consistency_iterations: each round estimates every view again with its sources' maps
+  // of the previous round as the prior (the .photometric maps in the first), and the last
+  // round's maps are filtered by consistency with the maps their prior came from. A view whose
+  // first estimate went wrong (synth_handheld h01: 49 mm behind the hair, put right by the first
+  // round's prior) gives its neighbours a wrong prior in the first round and a corrected one in
+  // the second. Measured (.geometric maps, 1 / 2 / 3 rounds): synth_handheld (views all
+  // around) 80.3 / 84.2 / 84.9% of the hair, per-pixel median 5.75 / 5.59 / 5.47 mm, mean 11.28
+  // / 10.97 / 10.82, 3D mean 2.13 / 1.84 / 1.82 mm, in 115 / 154 / 167 s; synth_straight_gantry
+  // (T groups) 98.4 / 98.7 / 98.7%, 4.55 mm each, mean 9.70 / 9.88 / 9.91, 3D mean 1.51 / 1.55
+  // / 1.51 mm, in 221 / 273 / 325 s; the curly demo group 2.35 / 2.36 mm (1 / 2). A round
+  // costs a third of a first estimate (a 1404 x 936 T group: 15.5 -> 20.8 s per map with two)
+  // and helps only where the views disagree, so a round after the first runs only while (a)
+  // more than geom_consistency_min_inconsistent_fraction of the previous round's depths are
+  // inconsistent with the maps their prior came from (the filter's test) and (b) from the
+  // third round on, the previous round raised the consistent fraction by at least
+  // geom_consistency_min_gain. The consistent fractions after rounds 1 / 2 / 3 (all views'
+  // depths, hair and head): synth_handheld 76.7 / 80.8 / 81.6%, so 3 rounds; the gantry 97.6%,
+  // a synthesised 1404 x 936 curly T group 97.9%, the curly demo 97.9%: 1 round. Exactly N
+  // rounds: min_inconsistent_fraction 0 and min_gain -1. Later rounds need every view's
+  // previous round, which only one process has: a job of an array takes its other views'
+  // .photometric maps in every round, and decides on its rounds from its own views.
+  int geom_consistency_iterations = 3;
+  double geom_consistency_min_inconsistent_fraction = 0.1;
+  double geom_consistency_min_gain = 0.01;
   // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
   // and visual-hull bound from the first estimate to the geometric pass, which would compute
   // them again (width x height x 36 bytes a view: 22 MiB at 960 x 640); views beyond it are
@@ -370,7 +380,11 @@ struct OrientationStereoOptions {
     v("coarse_volume_cache_mib", &coarse_volume_cache_mib,
       "MiB for keeping the coarse volumes from the first estimate to the geometric pass");
     v("geom_consistency_iterations", &geom_consistency_iterations,
-      "rounds of the geometric pass, each with the previous round's maps as the prior");
+      "most rounds of the geometric pass, each with the previous round's maps as the prior");
+    v("geom_consistency_min_inconsistent_fraction", &geom_consistency_min_inconsistent_fraction,
+      "another round only while more than this fraction of the depths is inconsistent");
+    v("geom_consistency_min_gain", &geom_consistency_min_gain,
+      "... and (from the third) while the last round added this much consistent fraction");
     v("geom_consistency_only", &geom_consistency_only,
       "only the geometric pass (prior and filter), on the existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,
@@ -398,6 +412,7 @@ struct OrientationStereoOptions {
 
 struct OrientationStereoResult {
   int num_views = 0;
+  int geometric_rounds = 0;  // rounds of the geometric pass that ran
   std::vector<std::string> depth_map_paths;
   double seconds = 0;
   double peak_memory_mib = 0;

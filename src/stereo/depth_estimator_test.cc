@@ -263,6 +263,12 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   options.geom_consistency_iterations = 0;
   ExpectRefusedNaming(options, "geom_consistency_iterations");
   options = OrientationStereoOptions();
+  options.geom_consistency_min_inconsistent_fraction = 1.5;
+  ExpectRefusedNaming(options, "geom_consistency_min_inconsistent_fraction");
+  options = OrientationStereoOptions();
+  options.geom_consistency_min_gain = -2;
+  ExpectRefusedNaming(options, "geom_consistency_min_gain");
+  options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
   options = OrientationStereoOptions();

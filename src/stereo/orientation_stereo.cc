@@ -130,6 +130,13 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
   if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
   if (geom_consistency_iterations < 1) e << "geom_consistency_iterations must be >= 1; ";
+  if (!(geom_consistency_min_inconsistent_fraction >= 0 &&
+        geom_consistency_min_inconsistent_fraction <= 1)) {
+    e << "geom_consistency_min_inconsistent_fraction must be in [0, 1]; ";
+  }
+  if (!(geom_consistency_min_gain >= -1 && geom_consistency_min_gain <= 1)) {
+    e << "geom_consistency_min_gain must be in [-1, 1]; ";
+  }
   if (coarse_volume_cache_mib < 0) e << "coarse_volume_cache_mib must be >= 0; ";
   if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
   if (geom_consistency_only && !geom_consistency) {
@@ -166,8 +173,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
 
 std::string OrientationStereoResult::BriefReport() const {
   std::ostringstream out;
-  out << "orientation_stereo: " << num_views << " depth maps in " << seconds
-      << " s; peak memory " << peak_memory_mib << " MiB";
+  out << "orientation_stereo: " << num_views << " depth maps";
+  if (geometric_rounds > 1) out << " (geometric pass in " << geometric_rounds << " rounds)";
+  out << " in " << seconds << " s; peak memory " << peak_memory_mib << " MiB";
   return out.str();
 }
 
@@ -574,12 +582,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
   if (options.geom_consistency) {
     // The geometric pass: every view estimated now (or, with geom_consistency_only, every
-    // requested view) is estimated again with its sources' maps as a prior, in
-    // geom_consistency_iterations rounds (each from the previous round's maps of every view,
-    // the .photometric ones first, so that the order of the views does not matter), and its
-    // final map filtered by consistency with the maps its prior came from (as COLMAP's
-    // geometric pass filters against the maps it reads: with one round, a job of an array
-    // gives the map one process would).
+    // requested view) is estimated again with its sources' maps as a prior, in rounds (each
+    // from the previous round's maps of every view, the .photometric ones first, so that the
+    // order of the views does not matter), and its final map filtered by consistency with the
+    // maps its prior came from (as COLMAP's geometric pass filters against the maps it reads:
+    // with one round, a job of an array gives the map one process would).
     const std::vector<std::string>& to_filter = options.geom_consistency_only ? names : estimated;
     // Each view's latest map but the last round's: its .photometric map (read once), then
     // each round's estimate.
@@ -625,14 +632,20 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       return maps;
     };
-    const int rounds = options.geom_prior_weight > 0 ? options.geom_consistency_iterations : 0;
-    for (int round = 0; round < rounds; ++round) {
-      const bool last_round = round + 1 == rounds;
+    // Up to geom_consistency_iterations rounds; after each but the last possible one, the
+    // round's maps are checked against the maps their prior came from, and the pass stops where
+    // nearly all of them agree or where the round added little agreement (see the options).
+    const int max_rounds =
+        options.geom_prior_weight > 0 ? options.geom_consistency_iterations : 0;
+    double previous_consistent = -1;  // the previous round's fraction of consistent depths
+    for (int round = 0; round < max_rounds; ++round) {
+      const bool last_possible_round = round + 1 == max_rounds;
       std::ostringstream task;
       task << "geometric consistency";
-      if (rounds > 1) task << ", round " << round + 1 << " of " << rounds;
+      if (max_rounds > 1) task << ", round " << round + 1 << " of at most " << max_rounds;
       Progress round_progress(task.str(), static_cast<int>(to_filter.size()));
       std::map<std::string, FusionView> next;
+      std::map<std::string, FloatMap> confidences;
       for (size_t i = 0; i < to_filter.size(); ++i) {
         const std::string& name = to_filter[i];
         round_progress.Start(static_cast<int>(i), name);
@@ -647,9 +660,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         prior.max_error_px = options.geom_prior_max_error_px;
         const auto cached = first_estimates.find(name);
         FirstEstimate* cache = cached != first_estimates.end() ? &cached->second : nullptr;
-        // The estimate takes the cached volume: a round before the last gets a copy.
+        // The estimate takes the cached volume: a round that may not be the last gets a copy.
         FirstEstimate copy;
-        if (cache != nullptr && !last_round) {
+        if (cache != nullptr && !last_possible_round) {
           copy = *cache;
           cache = &copy;
         }
@@ -659,17 +672,43 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           estimate.depth = std::move(view->estimate.depth);
           estimate.K = view->K;
           next.emplace(name, std::move(estimate));
-          // The confidence of the map that is written as .geometric.
-          if (last_round) WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
+          confidences.emplace(name, std::move(view->estimate.confidence));
         }
-        if (last_round) first_estimates.erase(name);
+        if (last_possible_round) first_estimates.erase(name);
       }
       round_progress.Finish();
-      if (last_round) {
-        final_maps = std::move(next);
-      } else {
-        for (auto& [name, view] : next) latest[name] = std::move(view);
+      ++result.geometric_rounds;
+      bool last_round = last_possible_round;
+      if (!last_round) {
+        ScopedStageTimer timer(timings, "consistency");
+        ConsistencyFilterStats total;
+        for (const auto& [name, estimate] : next) {
+          ConsistencyFilterStats stats;
+          FilterDepthMapByConsistency(estimate, maps_of(name).sources,
+                                      options.geom_consistency_max_error_px,
+                                      options.geom_consistency_min_views, &stats);
+          total.num_checked += stats.num_checked;
+          total.num_kept += stats.num_kept;
+        }
+        const double consistent =
+            total.num_checked > 0 ? static_cast<double>(total.num_kept) / total.num_checked : 1;
+        last_round = 1 - consistent <= options.geom_consistency_min_inconsistent_fraction ||
+                     (previous_consistent >= 0 &&
+                      consistent - previous_consistent < options.geom_consistency_min_gain);
+        std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
+                    round + 1, 100 * consistent, total.num_checked,
+                    last_round ? ": the last round" : ": another round");
+        previous_consistent = consistent;
       }
+      if (last_round) {
+        // The confidence of the maps that are written as .geometric.
+        for (const auto& [name, confidence] : confidences) {
+          WriteMat(workspace.ConfidenceMapPath(name), confidence);
+        }
+        final_maps = std::move(next);
+        break;
+      }
+      for (auto& [name, view] : next) latest[name] = std::move(view);
     }
     first_estimates.clear();
 
@@ -687,7 +726,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
       } else {
-        if (rounds > 0 && others.size() < maps.num_sources) {
+        if (max_rounds > 0 && others.size() < maps.num_sources) {
           LOG(WARNING) << name << ": " << others.size() << " of its " << maps.num_sources
                        << " source views have a .photometric depth map yet; its .geometric map "
                        << "is only filtered (run again with "

@@ -319,8 +319,13 @@ TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilt
   };
   OrientationStereoOptions options = PlaneOptions();
   options.geom_consistency_iterations = 2;
+  // Both rounds, however well the first round's maps agree.
+  options.geom_consistency_min_inconsistent_fraction = 0;
+  options.geom_consistency_min_gain = -1;
   StageTimings timings;
-  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  const OrientationStereoResult result = RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_EQ(result.num_views, 4);
+  EXPECT_EQ(result.geometric_rounds, 2);
   const std::vector<FloatMap> two_rounds = read_geometric();
 
   // One round, unfiltered (no view needs to agree).
@@ -352,6 +357,47 @@ TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilt
     EXPECT_LT(median, 0.02) << names[v];  // as one round (tests above)
   }
   EXPECT_GT(changed_by_second_round, 0u);  // the second round estimated the views again
+  std::filesystem::remove_all(path);
+}
+
+// A round after the first runs only while many depths disagree with the previous maps and, from
+// the third round on, while the last round added agreement.
+TEST(OrientationStereoWorkspace, RoundsStopWhereTheMapsAgree) {
+  const std::string path = MakeTestDir("stereo_round_stop");
+  WriteWorkspace(path);
+  const Workspace workspace = Workspace::Read(path);
+  auto read_geometric = [&]() {
+    std::vector<FloatMap> maps;
+    for (const std::string& name : kViewNames) {
+      maps.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
+    }
+    return maps;
+  };
+  StageTimings timings;
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_consistency_iterations = 1;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds, 1);
+  const std::vector<FloatMap> one_round = read_geometric();
+
+  // The default: the plane's first round agrees with the .photometric maps (far more than
+  // 90% of its depths), so it is the last one, and its maps are those of one round.
+  options.geom_consistency_iterations = OrientationStereoOptions().geom_consistency_iterations;
+  ASSERT_GT(options.geom_consistency_iterations, 1);
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds, 1);
+  const std::vector<FloatMap> stopped = read_geometric();
+  for (size_t v = 0; v < kViewNames.size(); ++v) {
+    EXPECT_EQ(stopped[v].Data(), one_round[v].Data()) << kViewNames[v];
+  }
+
+  // Always another round while any depth disagrees (the second round is not asked for a
+  // gain), but a gain no round can reach stops the pass after the second.
+  options.geom_consistency_min_inconsistent_fraction = 0;
+  options.geom_consistency_min_gain = 1;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds, 2);
+  // Without the gain test, as many rounds as allowed.
+  options.geom_consistency_min_gain = -1;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds,
+            options.geom_consistency_iterations);
   std::filesystem::remove_all(path);
 }
 
