@@ -96,6 +96,15 @@ OrientationStereoOptions PlaneOptions() {
   return options;
 }
 
+// The .geometric maps of kViewNames.
+std::vector<FloatMap> ReadGeometricMaps(const Workspace& workspace) {
+  std::vector<FloatMap> maps;
+  for (const std::string& name : kViewNames) {
+    maps.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
+  }
+  return maps;
+}
+
 TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane) {
   const std::string path = MakeTestDir("stereo_workspace");
   const FloatMap true_depth = WriteWorkspace(path)[0];
@@ -240,10 +249,7 @@ TEST(OrientationStereoWorkspace, GeometricPassEstimatesAgainWithTheSourcesMapsAs
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
   EXPECT_GT(timings.Get("geometric prior"), 0.0);
   const Workspace workspace = Workspace::Read(path);
-  std::vector<FloatMap> with_prior;
-  for (const std::string& name : names) {
-    with_prior.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
-  }
+  const std::vector<FloatMap> with_prior = ReadGeometricMaps(workspace);
   // The filter alone, on the same .photometric maps.
   options.geom_prior_weight = 0;
   options.geom_consistency_only = true;
@@ -310,13 +316,6 @@ TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilt
   const std::vector<FloatMap> true_depths = WriteWorkspace(path);
   const std::vector<std::string>& names = kViewNames;
   const Workspace workspace = Workspace::Read(path);
-  auto read_geometric = [&]() {
-    std::vector<FloatMap> maps;
-    for (const std::string& name : names) {
-      maps.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
-    }
-    return maps;
-  };
   OrientationStereoOptions options = PlaneOptions();
   options.geom_consistency_iterations = 2;
   // Both rounds, however well the first round's maps agree.
@@ -326,13 +325,13 @@ TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilt
   const OrientationStereoResult result = RunOrientationStereo(path, {}, options, &timings);
   EXPECT_EQ(result.num_views, 4);
   EXPECT_EQ(result.geometric_rounds, 2);
-  const std::vector<FloatMap> two_rounds = read_geometric();
+  const std::vector<FloatMap> two_rounds = ReadGeometricMaps(workspace);
 
   // One round, unfiltered (no view needs to agree).
   options.geom_consistency_iterations = 1;
   options.geom_consistency_min_views = 0;
   RunOrientationStereo(path, {}, options, &timings);
-  const std::vector<FloatMap> first_round = read_geometric();
+  const std::vector<FloatMap> first_round = ReadGeometricMaps(workspace);
   // ... as the .photometric maps of a geometric pass alone, filtered as by default.
   for (size_t v = 0; v < names.size(); ++v) {
     WriteMat(workspace.DepthMapPath(names[v], "photometric"), first_round[v]);
@@ -340,7 +339,7 @@ TEST(OrientationStereoWorkspace, SecondRoundUsesTheFirstRoundsMapsAsPriorAndFilt
   options.geom_consistency_min_views = OrientationStereoOptions().geom_consistency_min_views;
   options.geom_consistency_only = true;
   RunOrientationStereo(path, names, options, &timings);
-  const std::vector<FloatMap> round_again = read_geometric();
+  const std::vector<FloatMap> round_again = ReadGeometricMaps(workspace);
 
   size_t changed_by_second_round = 0;
   for (size_t v = 0; v < names.size(); ++v) {
@@ -366,25 +365,18 @@ TEST(OrientationStereoWorkspace, RoundsStopWhereTheMapsAgree) {
   const std::string path = MakeTestDir("stereo_round_stop");
   WriteWorkspace(path);
   const Workspace workspace = Workspace::Read(path);
-  auto read_geometric = [&]() {
-    std::vector<FloatMap> maps;
-    for (const std::string& name : kViewNames) {
-      maps.push_back(ReadMat(workspace.DepthMapPath(name, "geometric")));
-    }
-    return maps;
-  };
   StageTimings timings;
   OrientationStereoOptions options = PlaneOptions();
   options.geom_consistency_iterations = 1;
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds, 1);
-  const std::vector<FloatMap> one_round = read_geometric();
+  const std::vector<FloatMap> one_round = ReadGeometricMaps(workspace);
 
   // The default: the plane's first round agrees with the .photometric maps (far more than
   // 90% of its depths), so it is the last one, and its maps are those of one round.
   options.geom_consistency_iterations = OrientationStereoOptions().geom_consistency_iterations;
   ASSERT_GT(options.geom_consistency_iterations, 1);
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).geometric_rounds, 1);
-  const std::vector<FloatMap> stopped = read_geometric();
+  const std::vector<FloatMap> stopped = ReadGeometricMaps(workspace);
   for (size_t v = 0; v < kViewNames.size(); ++v) {
     EXPECT_EQ(stopped[v].Data(), one_round[v].Data()) << kViewNames[v];
   }
