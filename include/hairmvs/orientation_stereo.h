@@ -274,7 +274,7 @@ struct OrientationStereoOptions {
   // / 1.51 mm, in 221 / 273 / 325 s; the curly demo group 2.35 / 2.36 mm (1 / 2). A round
   // costs a third of a first estimate (a 1404 x 936 T group: 15.5 -> 20.8 s per map with two)
   // and helps only where the views disagree, so a round after the first runs only while (a)
-  // more than geom_consistency_min_inconsistent_fraction of the previous round's depths are
+  // at least geom_consistency_min_inconsistent_fraction of the previous round's depths are
   // inconsistent with the maps their prior came from (the filter's test) and (b) from the
   // third round on, the previous round raised the consistent fraction by at least
   // geom_consistency_min_gain. The consistent fractions after rounds 1 / 2 / 3 (all views'
@@ -382,7 +382,7 @@ struct OrientationStereoOptions {
     v("geom_consistency_iterations", &geom_consistency_iterations,
       "most rounds of the geometric pass, each with the previous round's maps as the prior");
     v("geom_consistency_min_inconsistent_fraction", &geom_consistency_min_inconsistent_fraction,
-      "another round only while more than this fraction of the depths is inconsistent");
+      "another round only while at least this fraction of the depths is inconsistent");
     v("geom_consistency_min_gain", &geom_consistency_min_gain,
       "... and (from the third) while the last round added this much consistent fraction");
     v("geom_consistency_only", &geom_consistency_only,

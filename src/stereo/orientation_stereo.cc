@@ -692,7 +692,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         }
         const double consistent =
             total.num_checked > 0 ? static_cast<double>(total.num_kept) / total.num_checked : 1;
-        last_round = 1 - consistent <= options.geom_consistency_min_inconsistent_fraction ||
+        last_round = 1 - consistent < options.geom_consistency_min_inconsistent_fraction ||
                      (previous_consistent >= 0 &&
                       consistent - previous_consistent < options.geom_consistency_min_gain);
         std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
