@@ -384,7 +384,7 @@ struct OrientationStereoOptions {
     v("geom_consistency_min_inconsistent_fraction", &geom_consistency_min_inconsistent_fraction,
       "another round only while at least this fraction of the depths is inconsistent");
     v("geom_consistency_min_gain", &geom_consistency_min_gain,
-      "... and (from the third) while the last round added this much consistent fraction");
+      "from the third round on, another only while the last added this consistent fraction");
     v("geom_consistency_only", &geom_consistency_only,
       "only the geometric pass (prior and filter), on the existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,
