@@ -66,10 +66,11 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   int max_image_size = -1;
   double depth_min = -1, depth_max = -1, min_triangulation_angle = 1.0;
   bool geom_consistency = true, filter = true;
-  int filter_min_num_consistent = 1;
-  double filter_geom_consistency_max_cost = 4.0;
-  double geom_consistency_max_cost = 3.0;
   OrientationStereoOptions options;
+  // hairmvs's defaults, not COLMAP's (2, 1 px, 3 px): see OrientationStereoOptions.
+  int filter_min_num_consistent = options.geom_consistency_min_views;
+  double filter_geom_consistency_max_cost = options.geom_consistency_max_error_px;
+  double geom_consistency_max_cost = options.geom_prior_max_error_px;
   SourceViewOptions source_options;
   OrientationFieldOptions field_options;
   OpenCLOptions opencl_options;
