@@ -267,7 +267,14 @@ struct OrientationStereoOptions {
   // 5.36 and 5.36 mm, with 10 px 5.34 / 5.44 mm: the depths added (5.3% of the hair at 6 px,
   // median 11.1 mm) are harder ones, those kept are no worse. The g2 group 99.6 -> 99.7% at
   // 4.03 -> 4.04 mm, the curly demo 97.9 -> 98.0% at 2.35 -> 2.36 mm (3 -> 6 px).
-  double geom_prior_weight = 1.0;
+  // With the 6 px reach and the rounds, weight 1 / 2 / 4: synth_handheld 88.3 / 93.4 / 94.6%
+  // of the hair at 5.56 / 5.61 / 5.79 mm (3D median 0.655 / 0.641 / 0.649 mm, mean 10.97 /
+  // 11.39 / 11.70), and on the pixels both keep 5.48 / 5.33 (1 / 2) and 5.51 / 5.60 (2 / 4):
+  // 2 is more accurate where 1 keeps a depth as well, 4 less; synth_straight_gantry (1 / 2)
+  // 98.5 / 98.8% at 4.57 / 4.58 mm (4.56 / 4.55 on the pixels both keep; the 0.5% added are
+  // 38 mm off, so the mean goes 9.74 -> 9.89 and the 3D mean 1.53 -> 1.59 mm); the g2 group
+  // 4.04 / 4.03 mm, the curly demo 98.0 / 98.3% at 2.36 / 2.37 mm.
+  double geom_prior_weight = 2.0;
   double geom_prior_max_error_px = 6.0;
   // Rounds of the geometric pass (with geom_prior_weight > 0), at most
   // geom_consistency_iterations: each round estimates every view again with its sources' maps
