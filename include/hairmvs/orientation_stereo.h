@@ -295,11 +295,12 @@ struct OrientationStereoOptions {
   // geom_consistency_min_gain. The consistent fractions after rounds 1 / 2 / 3 (all views'
   // depths, hair and head): synth_handheld 76.7 / 80.8 / 81.6%, so 3 rounds; the gantry 97.6%,
   // a synthesised 1404 x 936 curly T group 97.9%, the curly demo 97.9%: 1 round (all figures
-  // here with geom_prior_max_error_px 3; with 6, synth_handheld 80.0 / 84.9% after rounds 1 /
-  // 2, 3 rounds, 88.3% of the hair at 5.56 mm; the gantry 97.7%, 1 round). Exactly N
-  // rounds: min_inconsistent_fraction 0 and min_gain -1. Later rounds need every view's
-  // previous round, which only one process has: a job of an array takes its other views'
-  // .photometric maps in every round, and decides on its rounds from its own views.
+  // here with geom_prior_max_error_px 3 and weight 1; with 6 px and weight 2, synth_handheld
+  // 85.3 / 89.7% after rounds 1 / 2, 3 rounds, 93.4% of the hair at 5.61 mm; the gantry 98.1%,
+  // 1 round). Exactly N rounds: min_inconsistent_fraction 0 and min_gain -1. Later rounds
+  // need every view's previous round, which only one process has: a job of an array takes its
+  // other views' .photometric maps in every round, and decides on its rounds from its own
+  // views.
   int geom_consistency_iterations = 3;
   double geom_consistency_min_inconsistent_fraction = 0.1;
   double geom_consistency_min_gain = 0.01;
