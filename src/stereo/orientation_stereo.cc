@@ -591,7 +591,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     // Each view's latest map but the last round's: its .photometric map (read once), then
     // each round's estimate.
     std::map<std::string, FusionView> latest;
-    std::map<std::string, FusionView> final_maps;  // the last round's estimates
+    // The last round's estimates, filtered against the maps their prior came from.
+    struct FilteredMap {
+      FusionView view;
+      ConsistencyFilterStats stats;
+    };
+    std::map<std::string, FilteredMap> final_maps;
     auto load = [&](const std::string& name) -> const FusionView* {
       auto it = latest.find(name);
       if (it == latest.end()) {
@@ -632,9 +637,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       return maps;
     };
-    // Up to geom_consistency_iterations rounds; after each but the last possible one, the
-    // round's maps are checked against the maps their prior came from, and the pass stops where
-    // nearly all of them agree or where the round added little agreement (see the options).
+    // Up to geom_consistency_iterations rounds; each round's maps are filtered against the maps
+    // their prior came from, and the pass stops where nearly all of them agree or where the
+    // round added little agreement (see the options): the last round's filtered maps are the
+    // .geometric ones.
     const int max_rounds =
         options.geom_prior_weight > 0 ? options.geom_consistency_iterations : 0;
     double previous_consistent = -1;  // the previous round's fraction of consistent depths
@@ -678,34 +684,38 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       round_progress.Finish();
       ++result.geometric_rounds;
-      bool last_round = last_possible_round;
-      if (!last_round) {
+      std::map<std::string, FilteredMap> filtered;
+      ConsistencyFilterStats total;
+      {
         ScopedStageTimer timer(timings, "consistency");
-        ConsistencyFilterStats total;
         for (const auto& [name, estimate] : next) {
-          ConsistencyFilterStats stats;
-          FilterDepthMapByConsistency(estimate, maps_of(name).sources,
-                                      options.geom_consistency_max_error_px,
-                                      options.geom_consistency_min_views, &stats);
-          total.num_checked += stats.num_checked;
-          total.num_kept += stats.num_kept;
+          FilteredMap& map = filtered[name];
+          map.view = estimate;
+          map.view.depth = FilterDepthMapByConsistency(estimate, maps_of(name).sources,
+                                                       options.geom_consistency_max_error_px,
+                                                       options.geom_consistency_min_views,
+                                                       &map.stats);
+          total.num_checked += map.stats.num_checked;
+          total.num_kept += map.stats.num_kept;
         }
-        const double consistent =
-            total.num_checked > 0 ? static_cast<double>(total.num_kept) / total.num_checked : 1;
-        last_round = 1 - consistent < options.geom_consistency_min_inconsistent_fraction ||
-                     (previous_consistent >= 0 &&
-                      consistent - previous_consistent < options.geom_consistency_min_gain);
-        std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
-                    round + 1, 100 * consistent, total.num_checked,
-                    last_round ? ": the last round" : ": another round");
-        previous_consistent = consistent;
       }
+      const double consistent =
+          total.num_checked > 0 ? static_cast<double>(total.num_kept) / total.num_checked : 1;
+      const bool last_round =
+          last_possible_round ||
+          1 - consistent < options.geom_consistency_min_inconsistent_fraction ||
+          (previous_consistent >= 0 &&
+           consistent - previous_consistent < options.geom_consistency_min_gain);
+      std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
+                  round + 1, 100 * consistent, total.num_checked,
+                  last_round ? ": the last round" : ": another round");
+      previous_consistent = consistent;
       if (last_round) {
         // The confidence of the maps that are written as .geometric.
         for (const auto& [name, confidence] : confidences) {
           WriteMat(workspace.ConfidenceMapPath(name), confidence);
         }
-        final_maps = std::move(next);
+        final_maps = std::move(filtered);
         break;
       }
       for (auto& [name, view] : next) latest[name] = std::move(view);
@@ -718,10 +728,14 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       filter_progress.Start(static_cast<int>(i), name);
       const ViewMaps maps = maps_of(name);
       const std::vector<const FusionView*>& others = maps.sources;
+      FusionView estimate = *maps.ref;
       const auto estimated_again = final_maps.find(name);
-      FusionView estimate =
-          estimated_again != final_maps.end() ? estimated_again->second : *maps.ref;
-      if (others.empty()) {
+      if (estimated_again != final_maps.end()) {
+        estimate = std::move(estimated_again->second.view);  // filtered in its round
+        const ConsistencyFilterStats& stats = estimated_again->second.stats;
+        std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
+                    stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
+      } else if (others.empty()) {
         LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
