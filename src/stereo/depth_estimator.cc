@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 
 #include <Eigen/LU>
 
@@ -11,7 +12,6 @@
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
 #include "src/opencl/opencl_context.h"
-#include "src/stereo/consistency_filter.h"
 #include "src/stereo/cost_volume.h"
 #include "src/stereo/guided_filter.h"
 
@@ -196,42 +196,6 @@ FloatMap CostOnRangeLabels(const std::vector<float>& volume, const std::vector<f
 }
 
 }  // namespace
-
-void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_camera,
-                       double level0_px_per_grid_px, const DepthLabels& labels,
-                       const std::vector<float>& base, float step, int num_labels,
-                       float cost_scale, std::vector<float>* volume) {
-  if (prior.views.empty() || !(prior.weight > 0)) return;
-  const int width = grid_camera.width, height = grid_camera.height;
-  const size_t n = static_cast<size_t>(width) * height;
-  CHECK_EQ(volume->size(), n * num_labels);
-  const Eigen::Matrix3d K_inv = grid_camera.K.inverse();
-  const Eigen::Matrix3d R_t = grid_camera.R.transpose();
-  const double max_error = prior.max_error_px;
-  const float per_view =
-      static_cast<float>(prior.weight * cost_scale / prior.views.size());
-#pragma omp parallel for schedule(dynamic, 4)
-  for (int row = 0; row < height; ++row) {
-    for (int col = 0; col < width; ++col) {
-      const size_t p = static_cast<size_t>(row) * width + col;
-      const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
-      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
-      for (int k = 0; k < num_labels; ++k) {
-        const double depth = labels.Depth((base.empty() ? 0.0f : base[p]) + k * step);
-        const Eigen::Vector3d world = R_t * (ray * depth - grid_camera.t);
-        double total = 0;
-        for (const FusionView* view : prior.views) {
-          double error_px;
-          const bool seen = ForwardBackwardErrorPx(*view, world, grid_camera.K, grid_camera.R,
-                                                   grid_camera.t, centre, &error_px);
-          total += seen ? std::min(max_error, error_px * level0_px_per_grid_px) / max_error
-                        : 1.0;
-        }
-        (*volume)[static_cast<size_t>(k) * n + p] += per_view * static_cast<float>(total);
-      }
-    }
-  }
-}
 
 namespace {
 
@@ -493,12 +457,13 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     for (int k = 0; k < num_depths; ++k) data_term.label_depths.push_back(labels.Depth(k));
   }
   float prior_scale = 0;
+  std::optional<GeometricPriorCL> prior_cl;  // the views' maps on the device, for both stages
   if (use_prior) {
     ScopedStageTimer timer(timings, "geometric prior");
     prior_scale = MedianCostRange(coarse_volume, static_cast<size_t>(cw) * ch, num_depths);
-    AddGeometricPrior(*prior, ref.camera.PyramidLevel(coarse_level),
-                      LevelPixelsPerPixel(0, coarse_level), labels, coarse_grid_base, 1.0f,
-                      num_depths, prior_scale, &coarse_volume);
+    prior_cl.emplace(context, *prior);
+    prior_cl->Add(ref.camera.PyramidLevel(coarse_level), LevelPixelsPerPixel(0, coarse_level),
+                  labels, coarse_grid_base, 1.0f, num_depths, prior_scale, &coarse_volume);
   }
   if (penalize) {
     // On the coarse grid, the smallest bound of each block, so that it never excludes what a
@@ -573,8 +538,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     std::vector<float> fine_volume = build_volume(0, 0, band, base, step);
     if (use_prior) {
       ScopedStageTimer timer(timings, "geometric prior");
-      AddGeometricPrior(*prior, ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step,
-                        band, prior_scale, &fine_volume);
+      prior_cl->Add(ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step, band,
+                    prior_scale, &fine_volume);
     }
     if (penalize) {
       PenalizeInFrontOfBound(bound0, base[0], step, band, &fine_volume);

@@ -11,6 +11,7 @@
 #include "src/core/float_map.h"
 #include "src/core/timer.h"
 #include "src/fusion/fusion_view.h"
+#include "src/stereo/geometric_prior.h"
 #include "src/stereo/stereo_geometry.h"
 
 namespace hairmvs {
@@ -49,27 +50,6 @@ struct DepthEstimate {
   // before any prior or bound (coarse grid, one channel per label) and each label's depth.
   CostVolume coarse_data_term;
 };
-
-// COLMAP's geometric pass: other views' depth maps as a prior on this view's depth. A depth D
-// at pixel p costs weight * cost_scale * mean over the views of min(e, max_error_px) /
-// max_error_px, e the forward-backward reprojection error (level-0 pixels) of p's point at D
-// through that view's map (src/stereo/consistency_filter.h); a view that does not see the point
-// or has no depth there counts as max_error_px (COLMAP's geom_consistency_max_cost).
-// cost_scale: the median over the pixels of the data term's range across the coarse labels,
-// so that weight is relative to the data term whatever its units.
-struct GeometricPrior {
-  std::vector<const FusionView*> views;
-  double weight = 0;
-  double max_error_px = 0;
-};
-
-// Adds the prior to `volume` ([label][row][col] on the grid of `grid_camera`, whose pixels are
-// `level0_px_per_grid_px` level-0 pixels wide) for labels v = base(p) + k * step (base empty =
-// 0). Plain C++ (OpenMP): a few projections per label, next to the cost volume's hundreds.
-void AddGeometricPrior(const GeometricPrior& prior, const StereoCamera& grid_camera,
-                       double level0_px_per_grid_px, const DepthLabels& labels,
-                       const std::vector<float>& base, float step, int num_labels,
-                       float cost_scale, std::vector<float>* volume);
 
 // `coarse_volume_cache` (may be null): the coarse stage's aggregated data term, before any
 // prior or bound, which depends only on the views, labels and options; used (and emptied) when

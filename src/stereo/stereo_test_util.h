@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "src/core/float_map.h"
+#include "src/fusion/fusion_view.h"
 #include "src/stereo/stereo_geometry.h"
 
 namespace hairmvs {
@@ -227,6 +228,27 @@ inline FloatMap RandomMap(int width, int height, int channels, unsigned seed, fl
   FloatMap map(width, height, channels);
   for (float& v : map.Data()) v = uni(rng);
   return map;
+}
+
+// A camera at `center` looking at the origin along +z-ish (no roll), and the exact z-depth map
+// of the world plane z_world = 1 seen by it (all cameras sit at z_world = 0 and look up +z).
+inline FusionView PlaneView(const Eigen::Vector3d& center, double yaw_rad) {
+  FusionView view;
+  view.K << 100, 0, 40, 0, 100, 30, 0, 0, 1;
+  view.R = Eigen::AngleAxisd(yaw_rad, Eigen::Vector3d::UnitY()).toRotationMatrix().transpose();
+  view.t = -view.R * center;
+  view.depth = FloatMap(80, 60, 1, 0.0f);
+  const Eigen::Matrix3d K_inv = view.K.inverse();
+  for (int row = 0; row < 60; ++row) {
+    for (int col = 0; col < 80; ++col) {
+      // Ray in world coordinates; intersect z_world = 1.
+      const Eigen::Vector3d ray_cam = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+      const Eigen::Vector3d ray = view.R.transpose() * ray_cam;
+      const double s = (1.0 - center.z()) / ray.z();
+      view.depth.At(row, col) = static_cast<float>(s * ray_cam.z());
+    }
+  }
+  return view;
 }
 
 // The median |depth - truth| (m) over the pixels where both are > 0, and how many they are

@@ -1,0 +1,136 @@
+#include "src/stereo/geometric_prior.h"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <array>
+
+#include "src/core/logging.h"
+#include "src/opencl/opencl_context.h"
+#include "src/stereo/consistency_filter.h"
+
+namespace hairmvs {
+
+GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior& prior)
+    : context_(context),
+      num_views_(static_cast<int>(prior.views.size())),
+      weight_(prior.weight),
+      max_error_px_(prior.max_error_px),
+      kernel_(context->Program({"geometric_prior.cl"}), "geometric_prior") {
+  std::vector<float> maps;
+  std::vector<int> dims;
+  for (const FusionView* view : prior.views) {
+    cameras_.push_back({view->K, view->R, view->t});
+    dims.insert(dims.end(), {view->depth.Width(), view->depth.Height(),
+                             static_cast<int>(maps.size()), 0});
+    maps.insert(maps.end(), view->depth.Data().begin(), view->depth.Data().end());
+  }
+  maps.resize(std::max<size_t>(maps.size(), 1));
+  dims.resize(std::max<size_t>(dims.size(), 4));
+  depth_maps_ = cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                           sizeof(float) * maps.size(), maps.data());
+  view_dims_ = cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                          sizeof(int) * dims.size(), dims.data());
+}
+
+void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per_grid_px,
+                           const DepthLabels& labels, const std::vector<float>& base,
+                           float step, int num_labels, float cost_scale,
+                           std::vector<float>* volume) {
+  if (num_views_ == 0 || !(weight_ > 0) || num_labels < 1) return;
+  const int width = grid_camera.width, height = grid_camera.height;
+  const size_t n = static_cast<size_t>(width) * height;
+  CHECK_EQ(volume->size(), n * num_labels);
+  CHECK(base.empty() || base.size() == n);
+  // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
+  // precision keeps the errors to about 1e-4 px.
+  const Eigen::Matrix3d R_t = grid_camera.R.transpose();
+  std::array<float, 18> ref_params;
+  const Eigen::Matrix3d K_inv = grid_camera.K.inverse();
+  for (int i = 0; i < 9; ++i) {
+    ref_params[i] = static_cast<float>(K_inv(i / 3, i % 3));
+    ref_params[9 + i] = static_cast<float>(grid_camera.K(i / 3, i % 3));
+  }
+  std::vector<float> view_params;
+  for (const ViewCamera& view : cameras_) {
+    const Eigen::Matrix3d A = view.R * R_t;
+    const Eigen::Vector3d a = view.t - A * grid_camera.t;
+    const Eigen::Vector3d centre = grid_camera.R * (-view.R.transpose() * view.t) + grid_camera.t;
+    for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(A(i / 3, i % 3)));
+    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(a(i)));
+    for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(view.K(i / 3, i % 3)));
+    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(centre(i)));
+  }
+  cl::Context& cl_context = context_->Context();
+  auto upload = [&](const float* data, size_t count) {
+    return cl::Buffer(cl_context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                      sizeof(float) * std::max<size_t>(count, 1), const_cast<float*>(data));
+  };
+  const float no_base = 0.0f;
+  cl::Buffer ref_buffer = upload(ref_params.data(), ref_params.size());
+  cl::Buffer params_buffer = upload(view_params.data(), view_params.size());
+  cl::Buffer base_buffer = base.empty() ? upload(&no_base, 1) : upload(base.data(), n);
+  cl::Buffer volume_buffer(cl_context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                           sizeof(float) * volume->size(), volume->data());
+  const float per_view =
+      static_cast<float>(weight_ * cost_scale / num_views_);
+  cl::Kernel& k = kernel_;
+  int arg = 0;
+  k.setArg(arg++, width);
+  k.setArg(arg++, height);
+  k.setArg(arg++, ref_buffer);
+  k.setArg(arg++, depth_maps_);
+  k.setArg(arg++, params_buffer);
+  k.setArg(arg++, view_dims_);
+  k.setArg(arg++, num_views_);
+  k.setArg(arg++, base_buffer);
+  k.setArg(arg++, base.empty() ? 0 : 1);
+  k.setArg(arg++, step);
+  k.setArg(arg++, static_cast<float>(labels.a));
+  k.setArg(arg++, static_cast<float>(labels.b));
+  k.setArg(arg++, static_cast<int>(labels.inverse));
+  k.setArg(arg++, static_cast<float>(max_error_px_));
+  k.setArg(arg++, static_cast<float>(level0_px_per_grid_px));
+  k.setArg(arg++, per_view);
+  k.setArg(arg++, volume_buffer);
+  cl::CommandQueue& queue = context_->Queue();
+  queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width, height, num_labels));
+  queue.enqueueReadBuffer(volume_buffer, CL_TRUE, 0, sizeof(float) * volume->size(),
+                          volume->data());
+}
+
+void AddGeometricPriorCpu(const GeometricPrior& prior, const StereoCamera& grid_camera,
+                          double level0_px_per_grid_px, const DepthLabels& labels,
+                          const std::vector<float>& base, float step, int num_labels,
+                          float cost_scale, std::vector<float>* volume) {
+  if (prior.views.empty() || !(prior.weight > 0)) return;
+  const int width = grid_camera.width, height = grid_camera.height;
+  const size_t n = static_cast<size_t>(width) * height;
+  CHECK_EQ(volume->size(), n * num_labels);
+  const Eigen::Matrix3d K_inv = grid_camera.K.inverse();
+  const Eigen::Matrix3d R_t = grid_camera.R.transpose();
+  const double max_error = prior.max_error_px;
+  const float per_view =
+      static_cast<float>(prior.weight * cost_scale / prior.views.size());
+  for (int row = 0; row < height; ++row) {
+    for (int col = 0; col < width; ++col) {
+      const size_t p = static_cast<size_t>(row) * width + col;
+      const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
+      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+      for (int k = 0; k < num_labels; ++k) {
+        const double depth = labels.Depth((base.empty() ? 0.0f : base[p]) + k * step);
+        const Eigen::Vector3d world = R_t * (ray * depth - grid_camera.t);
+        double total = 0;
+        for (const FusionView* view : prior.views) {
+          double error_px;
+          const bool seen = ForwardBackwardErrorPx(*view, world, grid_camera.K, grid_camera.R,
+                                                   grid_camera.t, centre, &error_px);
+          total += seen ? std::min(max_error, error_px * level0_px_per_grid_px) / max_error
+                        : 1.0;
+        }
+        (*volume)[static_cast<size_t>(k) * n + p] += per_view * static_cast<float>(total);
+      }
+    }
+  }
+}
+
+}  // namespace hairmvs

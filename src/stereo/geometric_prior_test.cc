@@ -1,0 +1,124 @@
+#include "src/stereo/geometric_prior.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "src/opencl/opencl_context.h"
+#include "src/stereo/stereo_test_util.h"
+
+namespace hairmvs {
+namespace {
+
+using testing_util::PlaneView;
+
+// The prior uses the consistency filter's forward-backward error: 0 at the depth the other views' maps agree with, the most where they disagree by the maximum
+// error or do not see the point.
+TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
+  auto context = OpenCLContext::Create();
+  const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  const FusionView left = PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1);
+  FusionView blind = PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1);
+  for (float& d : blind.depth.Data()) d = 0.0f;  // no depth anywhere
+  StereoCamera camera;
+  camera.K = ref.K;
+  camera.R = ref.R;
+  camera.t = ref.t;
+  camera.width = ref.depth.Width();
+  camera.height = ref.depth.Height();
+  const DepthLabels labels(0.5, 2.0, 64, /*inverse=*/true);
+  const size_t n = static_cast<size_t>(camera.width) * camera.height;
+  GeometricPrior prior;
+  prior.views = {&left, &blind};
+  prior.weight = 2.0;
+  prior.max_error_px = 3.0;
+  std::vector<float> volume(n * labels.num_labels, 0.0f);
+  GeometricPriorCL prior_cl(context.get(), prior);
+  prior_cl.Add(camera, 1.0, labels, {}, 1.0f, labels.num_labels, 0.5f, &volume);
+  int checked = 0;
+  for (int row = 0; row < camera.height; ++row) {
+    for (int col = 20; col < 60; ++col) {  // the part of the reference the left view sees
+      const size_t p = static_cast<size_t>(row) * camera.width + col;
+      int best = 0;
+      for (int k = 1; k < labels.num_labels; ++k) {
+        if (volume[k * n + p] < volume[best * n + p]) best = k;
+      }
+      const double true_label = labels.Label(ref.depth.At(row, col));
+      EXPECT_LE(std::abs(best - true_label), 1.0) << row << " " << col;
+      // weight * scale = 1 over the two views: the blind one always adds 0.5, the left one
+      // nearly nothing at the true depth and 0.5 at labels far from it.
+      EXPECT_NEAR(volume[best * n + p], 0.5f, 0.1f);
+      EXPECT_FLOAT_EQ(volume[0 * n + p], 1.0f);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, 40 * 60);
+  // Labels relative to a per-pixel base (the fine band) score the same depths alike.
+  std::vector<float> base(n, 10.0f), band(n * 8, 0.0f);
+  prior_cl.Add(camera, 1.0, labels, base, 0.5f, 8, 0.5f, &band);
+  for (int k = 0; k < 8; ++k) {
+    const size_t p = 30 * camera.width + 40;
+    std::vector<float> single(n, 0.0f);
+    const std::vector<float> one_base(n, 10.0f + 0.5f * k);
+    prior_cl.Add(camera, 1.0, labels, one_base, 1.0f, 1, 0.5f, &single);
+    EXPECT_NEAR(band[k * n + p], single[p], 1e-6f) << k;
+  }
+}
+
+
+// The kernel against the plain double-precision reference on a coarse grid (2 level-0 pixels per
+// grid pixel) with per-pixel label bases: maps that disagree with the reference by a few pixels
+// (so that errors fall on both sides of max_error_px), holes, and a view that sees only part of
+// the reference.
+TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
+  auto context = OpenCLContext::Create();
+  const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  // Off the reference's rows and depth, so that grid points do not project onto the sources'
+  // pixel borders.
+  std::vector<FusionView> views = {PlaneView(Eigen::Vector3d(-0.1, 0.013, 0.02), 0.1),
+                                   PlaneView(Eigen::Vector3d(0.1, 0.05, -0.01), -0.1),
+                                   PlaneView(Eigen::Vector3d(0.3, -0.021, 0.005), 0.0)};
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> scale(0.9f, 1.1f), unit(0.0f, 1.0f);
+  for (FusionView& view : views) {
+    for (float& d : view.depth.Data()) d = unit(rng) < 0.1f ? 0.0f : d * scale(rng);
+  }
+  StereoCamera camera;
+  camera.K = ref.K;
+  camera.R = ref.R;
+  camera.t = ref.t;
+  camera.width = ref.depth.Width();
+  camera.height = ref.depth.Height();
+  const StereoCamera grid = camera.PyramidLevel(1);
+  const DepthLabels labels(0.5, 2.0, 64, /*inverse=*/true);
+  const size_t n = static_cast<size_t>(grid.width) * grid.height;
+  std::vector<float> base(n);
+  for (float& b : base) b = 40.0f * unit(rng);
+  GeometricPrior prior;
+  for (const FusionView& view : views) prior.views.push_back(&view);
+  prior.weight = 2.0;
+  prior.max_error_px = 6.0;
+  const int num_labels = 12;
+  for (bool with_base : {true, false}) {
+    const std::vector<float> label_base = with_base ? base : std::vector<float>();
+    const float step = with_base ? 0.75f : 5.0f;  // without a base: labels 0 to 55
+    std::vector<float> expected(n * num_labels, 0.25f), got = expected;
+    AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, 0.5f,
+                         &expected);
+    GeometricPriorCL(context.get(), prior)
+        .Add(grid, 2.0, labels, label_base, step, num_labels, 0.5f, &got);
+    // Single precision moves a projection by about 1e-4 px: where that crosses a pixel border
+    // of a source map, the two read neighbouring depths (a few entries in a million).
+    size_t close = 0, partial = 0;
+    for (size_t i = 0; i < got.size(); ++i) {
+      if (std::abs(got[i] - expected[i]) < 1e-4f) ++close;
+      // Neither all views at 0 nor all at the maximum: the entry measures real errors.
+      if (expected[i] > 0.26f && expected[i] < 1.24f) ++partial;
+    }
+    EXPECT_GE(close, got.size() - got.size() / 1000) << with_base;
+    EXPECT_GT(partial, got.size() / 4) << with_base;
+  }
+}
+
+}  // namespace
+}  // namespace hairmvs
