@@ -69,7 +69,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   cl::Buffer ref_buffer = upload(ref_params.data(), ref_params.size());
   cl::Buffer params_buffer = upload(view_params.data(), view_params.size());
   cl::Buffer base_buffer = base.empty() ? upload(&no_base, 1) : upload(base.data(), n);
-  cl::Buffer volume_buffer(cl_context, CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+  // The host volume itself (a CPU device adds in place; another copies it there and back).
+  cl::Buffer volume_buffer(cl_context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
                            sizeof(float) * volume->size(), volume->data());
   const float per_view =
       static_cast<float>(weight_ * cost_scale / num_views_);
@@ -94,8 +95,11 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   k.setArg(arg++, volume_buffer);
   cl::CommandQueue& queue = context_->Queue();
   queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width, height, num_labels));
-  queue.enqueueReadBuffer(volume_buffer, CL_TRUE, 0, sizeof(float) * volume->size(),
-                          volume->data());
+  void* mapped = queue.enqueueMapBuffer(volume_buffer, CL_TRUE, CL_MAP_READ, 0,
+                                        sizeof(float) * volume->size());
+  CHECK(mapped == volume->data());  // USE_HOST_PTR: the map is the host memory, up to date
+  queue.enqueueUnmapMemObject(volume_buffer, mapped);
+  queue.finish();
 }
 
 void AddGeometricPriorCpu(const GeometricPrior& prior, const StereoCamera& grid_camera,
