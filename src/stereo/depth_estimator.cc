@@ -79,12 +79,51 @@ namespace {
 
 // Per-level machinery of one reference view.
 struct LevelPipeline {
-  // The data term's costs and their weights (one, or orientation then colour when combined).
-  std::vector<std::pair<std::unique_ptr<CostVolumeCL>, float>> costs;
+  // The data term's costs (one, or orientation then colour when combined), each with its
+  // weight and its index in DataTerms(); with best_source_fraction < 1, one per term and
+  // source, each term's sources in the same order at every level.
+  struct Cost {
+    std::unique_ptr<CostVolumeCL> volume;
+    float weight;
+    int term;
+  };
+  std::vector<Cost> costs;
   std::unique_ptr<GuidedFilterCL> filter;
   int width = 0;
   int height = 0;
 };
+
+// best_source_fraction: per element, each term's num_best lowest costs among its sources,
+// summed and scaled by (the term's sources) / num_best, the terms added. costs[c] belongs to
+// volumes[c].
+void SumBestSources(const std::vector<std::vector<float>>& volumes,
+                    const std::vector<LevelPipeline::Cost>& costs, int num_best,
+                    std::vector<float>* out) {
+  std::vector<std::vector<size_t>> by_term;
+  for (size_t c = 0; c < costs.size(); ++c) {
+    if (costs[c].term >= static_cast<int>(by_term.size())) by_term.resize(costs[c].term + 1);
+    by_term[costs[c].term].push_back(c);
+  }
+  const long long size = static_cast<long long>(out->size());
+#pragma omp parallel
+  {
+    std::vector<float> values;
+#pragma omp for schedule(static)
+    for (long long i = 0; i < size; ++i) {
+      float total = 0;
+      for (const std::vector<size_t>& members : by_term) {
+        values.clear();
+        for (size_t c : members) values.push_back(volumes[c][i]);
+        const int k = std::min<int>(num_best, static_cast<int>(values.size()));
+        std::partial_sort(values.begin(), values.begin() + k, values.end());
+        float sum = 0;
+        for (int j = 0; j < k; ++j) sum += values[j];
+        total += sum * static_cast<float>(values.size()) / k;
+      }
+      (*out)[i] = total;
+    }
+  }
+}
 
 MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
   MrfSolverOptions mrf;
@@ -290,11 +329,15 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const bool strand_plane_from_hull =
       options.StrandPlaneFromVisualHull() && !visual_hull_entry.Empty();
   std::vector<LevelPipeline> levels(num_levels);
+  const int num_sources = static_cast<int>(sources.size());
+  const int num_best_sources = options.NumBestSources(num_sources);
+  const bool select_sources = num_best_sources < num_sources;
   {
     ScopedStageTimer timer(timings, "cost volume");
     const std::vector<std::pair<StereoCost, float>> terms = options.DataTerms();
     for (int l = 0; l < num_levels; ++l) {
-      for (const auto& [cost, weight] : terms) {
+      for (int term = 0; term < static_cast<int>(terms.size()); ++term) {
+        const auto& [cost, weight] = terms[term];
         auto matched = [cost = cost, l](const StereoViewData& view) -> const FloatMap& {
           if (cost == StereoCost::kPhotometric) return view.rgb[l];
           return view.matching.empty() ? view.orientation[l] : view.matching[l];
@@ -310,11 +353,20 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
         for (const StereoViewData* src : sources) {
           src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
         }
-        levels[l].costs.emplace_back(
-            std::make_unique<CostVolumeCL>(context, cost, ref_in, src_in,
-                                           options.orientation_transfer,
-                                           options.ncc_window_px / 2),
-            weight);
+        // Selecting sources needs each source's aggregated cost: one volume per source.
+        std::vector<std::vector<CostViewInput>> groups;
+        if (select_sources) {
+          for (const CostViewInput& one : src_in) groups.push_back({one});
+        } else {
+          groups.push_back(std::move(src_in));
+        }
+        for (const std::vector<CostViewInput>& group : groups) {
+          levels[l].costs.push_back(
+              {std::make_unique<CostVolumeCL>(context, cost, ref_in, group,
+                                              options.orientation_transfer,
+                                              options.ncc_window_px / 2),
+               weight, term});
+        }
       }
       levels[l].width = ref.orientation[l].Width();
       levels[l].height = ref.orientation[l].Height();
@@ -357,26 +409,46 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                 sizeof(float) * n, const_cast<float*>(base[l].data()));
       blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
     }
+    // Selecting sources: each cost's own volume, its levels summed, until the selection.
+    const size_t num_costs = levels[first_level].costs.size();
+    std::vector<cl::Buffer> cost_volumes;
+    for (size_t c = 0; c < num_costs && select_sources; ++c) {
+      cost_volumes.emplace_back(context->Context(), CL_MEM_READ_WRITE,
+                                sizeof(float) * host.size());
+      queue.enqueueFillBuffer(cost_volumes.back(), 0.0f, 0, sizeof(float) * host.size());
+    }
     for (int s0 = 0; s0 < num_labels; s0 += block) {
       const int ns = std::min(block, num_labels - s0);
       for (int l = first_level; l < num_levels; ++l) {
         // The guided filter is linear: each cost is aggregated and added with its weight.
-        for (const auto& [cost, weight] : levels[l].costs) {
+        for (size_t c = 0; c < levels[l].costs.size(); ++c) {
+          const LevelPipeline::Cost& cost = levels[l].costs[c];
           {
             ScopedStageTimer timer(timings, "cost volume");
-            cost->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
+            cost.volume->Compute(base_buffers[l], step, s0, ns, labels, blocks[l]);
             queue.finish();
           }
           ScopedStageTimer timer(timings, "aggregation");
           levels[l].filter->Filter(blocks[l], ns, blocks[l]);
-          resample.Run(blocks[l], levels[l].width, levels[l].height, ns, volume, gw, gh, s0,
-                       level_weight * weight,
+          resample.Run(blocks[l], levels[l].width, levels[l].height, ns,
+                       select_sources ? cost_volumes[c] : volume, gw, gh, s0,
+                       level_weight * cost.weight,
                        static_cast<float>(LevelPixelsPerPixel(l, grid_level)));
           queue.finish();
         }
       }
     }
-    queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());
+    if (!select_sources) {
+      queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());
+      return host;
+    }
+    ScopedStageTimer timer(timings, "source selection");
+    std::vector<std::vector<float>> per_cost(num_costs, std::vector<float>(host.size()));
+    for (size_t c = 0; c < num_costs; ++c) {
+      queue.enqueueReadBuffer(cost_volumes[c], CL_TRUE, 0, sizeof(float) * host.size(),
+                              per_cost[c].data());
+    }
+    SumBestSources(per_cost, levels[first_level].costs, num_best_sources, &host);
     return host;
   };
 

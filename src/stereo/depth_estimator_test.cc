@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "src/opencl/opencl_context.h"
@@ -308,6 +309,46 @@ TEST(DepthEstimator, CombinedCostIsTheWeightedSumOfTheTwoCosts) {
     EXPECT_LT(result->median_abs_error_m, 0.015);
     EXPECT_GT(result->completeness, 0.8);
   }
+}
+
+// best_source_fraction: per coarse label and pixel the data term is the sum of the lowest
+// aggregated costs among the sources (here the best 2 of 3, scaled by 3 / 2), each source's
+// cost as it is alone; Check refuses a fraction outside (0, 1].
+TEST(DepthEstimator, BestSourcesSumTheLowestCostsPerPixelAndDepth) {
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const std::vector<StereoCamera> cameras = TCameras({0, 0, 1});
+  OrientationStereoOptions options = TestOptions();
+  options.write_cost_volume = true;
+  std::vector<std::vector<float>> alone;
+  for (size_t s = 1; s < cameras.size(); ++s) {
+    alone.push_back(
+        Reconstruct(plane, {cameras[0], cameras[s]}, 0.7, 1.5, options, 1).coarse_data_term.Data());
+  }
+  options.best_source_fraction = 2.0 / 3;
+  EXPECT_EQ(options.NumBestSources(3), 2);
+  const Result best = Reconstruct(plane, cameras, 0.7, 1.5, options, 1);
+  const std::vector<float>& got = best.coarse_data_term.Data();
+  ASSERT_EQ(got.size(), alone[0].size());
+  double max_difference = 0, max_cost = 0;
+  size_t differs_from_sum = 0;
+  for (size_t i = 0; i < got.size(); ++i) {
+    std::array<float, 3> c = {alone[0][i], alone[1][i], alone[2][i]};
+    std::sort(c.begin(), c.end());
+    max_difference = std::max(max_difference, std::abs(got[i] - 1.5 * (c[0] + c[1])));
+    max_cost = std::max(max_cost, std::abs(static_cast<double>(c[0])));
+    if (std::abs(got[i] - (c[0] + c[1] + c[2])) > 1e-3 * std::abs(c[2])) ++differs_from_sum;
+  }
+  EXPECT_GT(max_cost, 0.1);
+  EXPECT_LT(max_difference, 1e-4 * max_cost);
+  EXPECT_GT(differs_from_sum, got.size() / 2);  // the selection changed the data term
+  EXPECT_LT(best.median_abs_error_m, 0.01);
+  EXPECT_GT(best.completeness, 0.8);
+  options.best_source_fraction = 0;
+  ExpectRefusedNaming(options, "best_source_fraction");
+  options.best_source_fraction = 1.5;
+  ExpectRefusedNaming(options, "best_source_fraction");
 }
 
 // A rolled source: the reference's orientations must be carried into it, by the paper's epipole

@@ -100,6 +100,12 @@ bool FromString(const std::string& text, VisualHullBound* bound) {
   return EnumFromName(kVisualHullBoundNames, text, bound);
 }
 
+int OrientationStereoOptions::NumBestSources(int num_sources) const {
+  // The small margin keeps, e.g., 2/3 of 3 sources at 2 despite rounding.
+  return std::clamp(static_cast<int>(std::ceil(best_source_fraction * num_sources - 1e-9)), 1,
+                    std::max(num_sources, 1));
+}
+
 std::vector<std::pair<StereoCost, float>> OrientationStereoOptions::DataTerms() const {
   if (cost != StereoCost::kCombined) return {{cost, 1.0f}};
   return {{StereoCost::kOrientation, static_cast<float>(1 - photometric_weight)},
@@ -166,6 +172,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
   if (!(photometric_weight >= 0 && photometric_weight <= 1)) {
     e << "photometric_weight must be in [0, 1]; ";
+  }
+  if (!(best_source_fraction > 0 && best_source_fraction <= 1)) {
+    e << "best_source_fraction must be in (0, 1]; ";
   }
   *error = e.str();
   return error->empty();
