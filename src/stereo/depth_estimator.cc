@@ -99,28 +99,36 @@ struct LevelPipeline {
 void SumBestSources(const std::vector<std::vector<float>>& volumes,
                     const std::vector<LevelPipeline::Cost>& costs, int num_best,
                     std::vector<float>* out) {
-  std::vector<std::vector<size_t>> by_term;
+  std::vector<std::vector<const float*>> by_term;
   for (size_t c = 0; c < costs.size(); ++c) {
     if (costs[c].term >= static_cast<int>(by_term.size())) by_term.resize(costs[c].term + 1);
-    by_term[costs[c].term].push_back(c);
+    by_term[costs[c].term].push_back(volumes[c].data());
   }
   const long long size = static_cast<long long>(out->size());
+  std::fill(out->begin(), out->end(), 0.0f);
+  for (const std::vector<const float*>& members : by_term) {
+    const int n = static_cast<int>(members.size());
+    if (n == 0) continue;
+    const int k = std::min(num_best, n);
+    const float scale = static_cast<float>(n) / k;
 #pragma omp parallel
-  {
-    std::vector<float> values;
+    {
+      std::vector<float> lowest(k);  // ascending
 #pragma omp for schedule(static)
-    for (long long i = 0; i < size; ++i) {
-      float total = 0;
-      for (const std::vector<size_t>& members : by_term) {
-        values.clear();
-        for (size_t c : members) values.push_back(volumes[c][i]);
-        const int k = std::min<int>(num_best, static_cast<int>(values.size()));
-        std::partial_sort(values.begin(), values.begin() + k, values.end());
+      for (long long i = 0; i < size; ++i) {
+        // Insertion into the k lowest so far: sources are few.
+        int count = 0;
+        for (const float* member : members) {
+          const float value = member[i];
+          if (count == k && value >= lowest[k - 1]) continue;
+          int j = count < k ? count++ : k - 1;
+          for (; j > 0 && lowest[j - 1] > value; --j) lowest[j] = lowest[j - 1];
+          lowest[j] = value;
+        }
         float sum = 0;
-        for (int j = 0; j < k; ++j) sum += values[j];
-        total += sum * static_cast<float>(values.size()) / k;
+        for (int j = 0; j < k; ++j) sum += lowest[j];
+        (*out)[i] += scale * sum;
       }
-      (*out)[i] = total;
     }
   }
 }
