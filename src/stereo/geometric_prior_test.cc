@@ -12,6 +12,17 @@ namespace {
 
 using testing_util::PlaneView;
 
+// The stereo camera of a view's depth map.
+StereoCamera CameraOf(const FusionView& view) {
+  StereoCamera camera;
+  camera.K = view.K;
+  camera.R = view.R;
+  camera.t = view.t;
+  camera.width = view.depth.Width();
+  camera.height = view.depth.Height();
+  return camera;
+}
+
 // The prior uses the consistency filter's forward-backward error: 0 at the depth the other views' maps agree with, the most where they disagree by the maximum
 // error or do not see the point.
 TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
@@ -20,12 +31,7 @@ TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
   const FusionView left = PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1);
   FusionView blind = PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1);
   for (float& d : blind.depth.Data()) d = 0.0f;  // no depth anywhere
-  StereoCamera camera;
-  camera.K = ref.K;
-  camera.R = ref.R;
-  camera.t = ref.t;
-  camera.width = ref.depth.Width();
-  camera.height = ref.depth.Height();
+  const StereoCamera camera = CameraOf(ref);
   const DepthLabels labels(0.5, 2.0, 64, /*inverse=*/true);
   const size_t n = static_cast<size_t>(camera.width) * camera.height;
   GeometricPrior prior;
@@ -83,13 +89,7 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   for (FusionView& view : views) {
     for (float& d : view.depth.Data()) d = unit(rng) < 0.1f ? 0.0f : d * scale(rng);
   }
-  StereoCamera camera;
-  camera.K = ref.K;
-  camera.R = ref.R;
-  camera.t = ref.t;
-  camera.width = ref.depth.Width();
-  camera.height = ref.depth.Height();
-  const StereoCamera grid = camera.PyramidLevel(1);
+  const StereoCamera grid = CameraOf(ref).PyramidLevel(1);
   const DepthLabels labels(0.5, 2.0, 64, /*inverse=*/true);
   const size_t n = static_cast<size_t>(grid.width) * grid.height;
   std::vector<float> base(n);
