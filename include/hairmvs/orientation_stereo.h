@@ -239,13 +239,13 @@ struct OrientationStereoOptions {
   // N / that count, so that the cost keeps its scale against lambda), so that a point hidden
   // from some sources (hair behind the front strands, seen through gaps that move between views)
   // is judged by the sources that see it. 1 = every source (the paper's Eq. 4). Each source is
-  // then aggregated on its own: the aggregation's time times N. Measured (best 2 of the T
-  // groups' 3 sources, against 1): synth_straight_gantry .geometric 98.8 -> 98.6% covered, median
-  // 4.58 -> 4.44 mm, mean 9.89 -> 9.64, 3D median 0.575 -> 0.552 mm, the depths' layer 27 -> 31%,
-  // 161 -> 313 s; synth_handheld (best 3 of 6) 93.4 -> 92.8%, 5.61 -> 5.57 mm, 3D median 0.641
-  // -> 0.665 mm, 117 -> 280 s. Hence not the default. Selecting in the fine band only (the
-  // coarse stage summing every source) keeps less of the gain for less time: the gantry 4.51 mm
-  // in 218 s, the handheld 5.62 mm in 179 s.
+  // then aggregated on its own: the aggregation's time times N. Measured (0.5: 2 of a T
+  // group's 3 sources, 3 of 6), against 1: synth_straight_gantry .geometric 98.8 -> 98.6%
+  // covered, median 4.58 -> 4.47 mm, mean 9.89 -> 9.65, 3D median 0.575 -> 0.556 mm, the
+  // depths' layer 27 -> 29%, 161 -> 301 s; synth_handheld 93.4 -> 92.8%, 5.61 -> 5.57 mm, 3D
+  // median 0.647 -> 0.658 mm, 117 -> 262 s; the curly demo 2.37 -> 2.38 mm. Hence not the
+  // default. Selecting in the fine band only (the coarse stage summing every source) keeps less
+  // of the gain for less time: the gantry 4.51 mm in 218 s, the handheld 5.62 mm in 179 s.
   double best_source_fraction = 1.0;
   // Geometric consistency, as COLMAP's patch_match_stereo names its passes: each view's depth
   // map as first estimated is written as depth_maps/<name>.photometric.bin. The geometric pass

@@ -6,8 +6,6 @@
 #include <memory>
 #include <optional>
 
-#include <Eigen/LU>
-
 #include "src/core/logging.h"
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
