@@ -218,3 +218,25 @@ __kernel void resample_accumulate(__global const float* src, int src_width, int 
       Bilinear1(src + (size_t)k * src_width * src_height, src_width, src_height, x, y);
   volume[(size_t)(slice_offset + k) * width * height + row * width + col] += scale * value;
 }
+
+// best_source_fraction (src/stereo/cost_volume.h, SumBestSourcesCL): out[i] += count / num_best
+// x the sum of the num_best lowest of volumes[(first + c) * size + i], c < count (ties to the
+// lower c), summed in the order of c. One work-item per element; sources are few, so each
+// value's rank is counted directly.
+__kernel void sum_best_sources(__global const float* volumes, int first, int count,
+                               int num_best, long size, float scale, __global float* out) {
+  const long i = get_global_id(0);
+  if (i >= size) return;
+  __global const float* column = volumes + (long)first * size + i;
+  float sum = 0.0f;
+  for (int c = 0; c < count; ++c) {
+    const float value = column[(long)c * size];
+    int rank = 0;
+    for (int m = 0; m < count; ++m) {
+      const float other = column[(long)m * size];
+      rank += (other < value || (other == value && m < c)) ? 1 : 0;
+    }
+    if (rank < num_best) sum += value;
+  }
+  out[i] += scale * sum;
+}

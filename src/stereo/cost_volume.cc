@@ -331,6 +331,40 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
   return out;
 }
 
+SumBestSourcesCL::SumBestSourcesCL(OpenCLContext* context)
+    : context_(context), kernel_(CostProgram(context), "sum_best_sources") {}
+
+void SumBestSourcesCL::Run(const cl::Buffer& volumes, int first, int count, int num_best,
+                           size_t size, const cl::Buffer& out) {
+  CHECK(count >= 1 && num_best >= 1 && num_best <= count);
+  kernel_.setArg(0, volumes);
+  kernel_.setArg(1, first);
+  kernel_.setArg(2, count);
+  kernel_.setArg(3, num_best);
+  kernel_.setArg(4, static_cast<cl_long>(size));
+  kernel_.setArg(5, static_cast<float>(count) / num_best);
+  kernel_.setArg(6, out);
+  context_->Queue().enqueueNDRangeKernel(kernel_, cl::NullRange, cl::NDRange(size));
+}
+
+void SumBestSourcesCpu(const std::vector<float>& volumes, int first, int count, int num_best,
+                       size_t size, std::vector<float>* out) {
+  std::vector<int> order(count);
+  for (size_t i = 0; i < size; ++i) {
+    auto value = [&](int c) { return volumes[(first + c) * size + i]; };
+    for (int c = 0; c < count; ++c) order[c] = c;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return value(a) < value(b); });
+    std::vector<bool> chosen(count, false);
+    for (int j = 0; j < num_best; ++j) chosen[order[j]] = true;
+    float sum = 0.0f;
+    for (int c = 0; c < count; ++c) {
+      if (chosen[c]) sum += value(c);
+    }
+    (*out)[i] += static_cast<float>(count) / num_best * sum;
+  }
+}
+
 ResampleAccumulateCL::ResampleAccumulateCL(OpenCLContext* context)
     : context_(context), kernel_(CostProgram(context), "resample_accumulate") {}
 

@@ -108,6 +108,24 @@ class ResampleAccumulateCL {
   cl::Kernel kernel_;
 };
 
+// best_source_fraction (kernels/cost_volume.cl): out[i] += count / num_best x the sum of the
+// num_best lowest of volumes[(first + c) * size + i] over c < count (ties to the lower c), for
+// i < size: `volumes` holds the sources' volumes one after another.
+class SumBestSourcesCL {
+ public:
+  explicit SumBestSourcesCL(OpenCLContext* context);
+  void Run(const cl::Buffer& volumes, int first, int count, int num_best, size_t size,
+           const cl::Buffer& out);
+
+ private:
+  OpenCLContext* context_;
+  cl::Kernel kernel_;
+};
+
+// The same in plain C++ (the kernel's test reference): the lowest chosen by a stable sort.
+void SumBestSourcesCpu(const std::vector<float>& volumes, int first, int count, int num_best,
+                       size_t size, std::vector<float>* out);
+
 // Bilinear resampling of every channel to width x height, an output pixel being
 // src_pixels_per_pixel input pixels wide from the same origin (pyramid levels; SfM centres,
 // clamped at the border): the CPU twin of resample_accumulate.

@@ -141,3 +141,44 @@ TEST(CostVolume, ResampleBilinearFollowsThePyramidsGrid) {
 
 }  // namespace
 }  // namespace hairmvs
+
+namespace hairmvs {
+namespace {
+
+// best_source_fraction's selection against the plain reference: 5 sources' volumes of values
+// on a coarse grid (so that ties occur), each term's k lowest of its sources summed and scaled,
+// added to what `out` holds.
+TEST(SumBestSources, KernelMatchesTheCpuReference) {
+  auto context = OpenCLContext::Create();
+  const size_t size = 3000;
+  const int num_volumes = 5;
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> level(-8, 8);
+  std::vector<float> volumes(size * num_volumes);
+  for (float& v : volumes) v = 0.25f * level(rng);
+  const std::vector<float> start(size, 0.5f);
+  cl::Buffer volumes_buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                            sizeof(float) * volumes.size(), volumes.data());
+  SumBestSourcesCL select(context.get());
+  // Two terms, as the combined cost has: volumes 0-2 and 3-4.
+  for (int num_best : {1, 2, 3}) {
+    std::vector<float> expected = start, got(size);
+    SumBestSourcesCpu(volumes, 0, 3, num_best, size, &expected);
+    SumBestSourcesCpu(volumes, 3, 2, std::min(num_best, 2), size, &expected);
+    cl::Buffer out(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                   sizeof(float) * size, const_cast<float*>(start.data()));
+    select.Run(volumes_buffer, 0, 3, num_best, size, out);
+    select.Run(volumes_buffer, 3, 2, std::min(num_best, 2), size, out);
+    context->Queue().enqueueReadBuffer(out, CL_TRUE, 0, sizeof(float) * size, got.data());
+    for (size_t i = 0; i < size; ++i) {
+      ASSERT_NEAR(got[i], expected[i], 1e-5f) << "element " << i << ", best " << num_best;
+    }
+  }
+  // The reference itself on one element: 3 sources at 1, -2, -2 with the best 2: (-2 - 2) x 3/2.
+  std::vector<float> one = {1.0f, -2.0f, -2.0f}, sum = {0.0f};
+  SumBestSourcesCpu(one, 0, 3, 2, 1, &sum);
+  EXPECT_FLOAT_EQ(sum[0], -6.0f);
+}
+
+}  // namespace
+}  // namespace hairmvs

@@ -91,46 +91,6 @@ struct LevelPipeline {
   int height = 0;
 };
 
-// best_source_fraction: per element, each term's num_best lowest costs among its sources,
-// summed and scaled by (the term's sources) / num_best, the terms added. costs[c] belongs to
-// volumes[c].
-void SumBestSources(const std::vector<std::vector<float>>& volumes,
-                    const std::vector<LevelPipeline::Cost>& costs, int num_best,
-                    std::vector<float>* out) {
-  std::vector<std::vector<const float*>> by_term;
-  for (size_t c = 0; c < costs.size(); ++c) {
-    if (costs[c].term >= static_cast<int>(by_term.size())) by_term.resize(costs[c].term + 1);
-    by_term[costs[c].term].push_back(volumes[c].data());
-  }
-  const long long size = static_cast<long long>(out->size());
-  std::fill(out->begin(), out->end(), 0.0f);
-  for (const std::vector<const float*>& members : by_term) {
-    const int n = static_cast<int>(members.size());
-    if (n == 0) continue;
-    const int k = std::min(num_best, n);
-    const float scale = static_cast<float>(n) / k;
-#pragma omp parallel
-    {
-      std::vector<float> lowest(k);  // ascending
-#pragma omp for schedule(static)
-      for (long long i = 0; i < size; ++i) {
-        // Insertion into the k lowest so far: sources are few.
-        int count = 0;
-        for (const float* member : members) {
-          const float value = member[i];
-          if (count == k && value >= lowest[k - 1]) continue;
-          int j = count < k ? count++ : k - 1;
-          for (; j > 0 && lowest[j - 1] > value; --j) lowest[j] = lowest[j - 1];
-          lowest[j] = value;
-        }
-        float sum = 0;
-        for (int j = 0; j < k; ++j) sum += lowest[j];
-        (*out)[i] += scale * sum;
-      }
-    }
-  }
-}
-
 MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
   MrfSolverOptions mrf;
   THROW_IF(!FromString(options.mrf_solver, &mrf.solver),
@@ -415,13 +375,15 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
                                 sizeof(float) * n, const_cast<float*>(base[l].data()));
       blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
     }
-    // Selecting sources: each cost's own volume, its levels summed, until the selection.
-    const size_t num_costs = levels[first_level].costs.size();
-    std::vector<cl::Buffer> cost_volumes;
-    for (size_t c = 0; c < num_costs && select_sources; ++c) {
-      cost_volumes.emplace_back(context->Context(), CL_MEM_READ_WRITE,
-                                sizeof(float) * host.size());
-      queue.enqueueFillBuffer(cost_volumes.back(), 0.0f, 0, sizeof(float) * host.size());
+    // Selecting sources: each cost's own volume (one after another in `source_volumes`), its
+    // levels summed, until the selection.
+    const std::vector<LevelPipeline::Cost>& costs = levels[first_level].costs;
+    const size_t num_costs = costs.size();
+    cl::Buffer source_volumes;
+    if (select_sources) {
+      const size_t bytes = sizeof(float) * host.size() * num_costs;
+      source_volumes = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, bytes);
+      queue.enqueueFillBuffer(source_volumes, 0.0f, 0, bytes);
     }
     for (int s0 = 0; s0 < num_labels; s0 += block) {
       const int ns = std::min(block, num_labels - s0);
@@ -437,24 +399,29 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
           ScopedStageTimer timer(timings, "aggregation");
           levels[l].filter->Filter(blocks[l], ns, blocks[l]);
           resample.Run(blocks[l], levels[l].width, levels[l].height, ns,
-                       select_sources ? cost_volumes[c] : volume, gw, gh, s0,
+                       select_sources ? source_volumes : volume, gw, gh,
+                       select_sources ? static_cast<int>(c) * num_labels + s0 : s0,
                        level_weight * cost.weight,
                        static_cast<float>(LevelPixelsPerPixel(l, grid_level)));
           queue.finish();
         }
       }
     }
-    if (!select_sources) {
-      queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());
-      return host;
+    if (select_sources) {
+      // Each term's sources lie together in `costs` (one term after the other).
+      ScopedStageTimer timer(timings, "source selection");
+      SumBestSourcesCL select(context);
+      for (size_t first = 0; first < num_costs;) {
+        size_t end = first;
+        while (end < num_costs && costs[end].term == costs[first].term) ++end;
+        const int count = static_cast<int>(end - first);
+        select.Run(source_volumes, static_cast<int>(first), count,
+                   std::min(num_best_sources, count), host.size(), volume);
+        first = end;
+      }
+      queue.finish();
     }
-    ScopedStageTimer timer(timings, "source selection");
-    std::vector<std::vector<float>> per_cost(num_costs, std::vector<float>(host.size()));
-    for (size_t c = 0; c < num_costs; ++c) {
-      queue.enqueueReadBuffer(cost_volumes[c], CL_TRUE, 0, sizeof(float) * host.size(),
-                              per_cost[c].data());
-    }
-    SumBestSources(per_cost, levels[first_level].costs, num_best_sources, &host);
+    queue.enqueueReadBuffer(volume, CL_TRUE, 0, sizeof(float) * host.size(), host.data());
     return host;
   };
 
