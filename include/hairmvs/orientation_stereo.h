@@ -241,8 +241,8 @@ struct OrientationStereoOptions {
   // is judged by the sources that see it. 1 = every source (the paper's Eq. 4). Each source is
   // then aggregated on its own: the aggregation's time times N. Measured (0.5: 2 of a T
   // group's 3 sources, 3 of 6), against 1: synth_straight_gantry .geometric 98.8 -> 98.6%
-  // covered, median 4.58 -> 4.47 mm, mean 9.89 -> 9.65, 3D median 0.575 -> 0.556 mm, the
-  // depths' layer 27 -> 29%, 161 -> 301 s; synth_handheld 93.4 -> 92.8%, 5.61 -> 5.57 mm, 3D
+  // covered, median 4.58 -> 4.47 mm, mean 9.89 -> 9.65, 3D median 0.575 -> 0.559 mm, the
+  // depths' layer 27 -> 29%, 161 -> 295 s; synth_handheld 93.4 -> 92.8%, 5.61 -> 5.57 mm, 3D
   // median 0.647 -> 0.658 mm, 117 -> 262 s (0.67, 4 of 6: 92.9%, 5.51 mm, 3D median 0.655 mm,
   // 252 s); the curly demo 2.37 -> 2.38 mm. Hence not the
   // default. Selecting in the fine band only (the coarse stage summing every source) keeps less
