@@ -280,4 +280,9 @@ cl::Program& OpenCLContext::BuildProgram(const std::string& source,
   return programs_.emplace(key, std::move(program)).first->second;
 }
 
+cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes) {
+  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                    std::max<size_t>(bytes, 4), const_cast<void*>(data));
+}
+
 }  // namespace hairmvs

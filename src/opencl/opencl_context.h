@@ -91,6 +91,10 @@ class OpenCLContext {
   std::map<std::string, cl::Program> programs_;
 };
 
+// A read-only device buffer holding a copy of `bytes` bytes at `data` (at least 4 bytes, so that
+// an empty array still gives a valid kernel argument).
+cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes);
+
 // The text of `file` from the embedded kernels, with `#include "x.clh"` lines replaced by the
 // included file (recursively, each at most once). Throws hairmvs::Error for an unknown file.
 std::string ResolveKernelSource(const std::string& file);

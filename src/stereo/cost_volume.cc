@@ -14,11 +14,6 @@ namespace {
 
 cl::Program& CostProgram(OpenCLContext* context) { return context->Program({"cost_volume.cl"}); }
 
-cl::Buffer Upload(OpenCLContext* context, const void* data, size_t bytes) {
-  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                    std::max<size_t>(bytes, 4), const_cast<void*>(data));
-}
-
 // Bilinear sample with pixel centres at integers; false outside [0, w-1] x [0, h-1].
 bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double* value) {
   const int w = map.Width(), h = map.Height();
@@ -59,7 +54,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
   CHECK_EQ(ref.field.Channels(), expected_channels);
   CHECK_EQ(ref.camera.width, width_);
   CHECK_EQ(ref.camera.height, height_);
-  ref_ = Upload(context, ref.field.Data().data(), sizeof(float) * ref.field.Data().size());
+  ref_ = ReadOnlyBuffer(context, ref.field.Data().data(), sizeof(float) * ref.field.Data().size());
   std::vector<float> params;
   std::vector<int> dims;
   std::vector<float> all_sources;
@@ -84,15 +79,16 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     }
     source_sizes_.push_back({src.field.Width(), src.field.Height()});
     if (cost == StereoCost::kPhotometric) {
-      source_buffers_.push_back(
-          Upload(context, src.field.Data().data(), sizeof(float) * src.field.Data().size()));
-      source_params_.push_back(Upload(context, packed.data(), sizeof(float) * packed.size()));
+      source_buffers_.push_back(ReadOnlyBuffer(context, src.field.Data().data(),
+                                               sizeof(float) * src.field.Data().size()));
+      source_params_.push_back(
+          ReadOnlyBuffer(context, packed.data(), sizeof(float) * packed.size()));
     }
   }
-  params_ = Upload(context, params.data(), sizeof(float) * params.size());
-  dims_ = Upload(context, dims.data(), sizeof(int) * dims.size());
+  params_ = ReadOnlyBuffer(context, params.data(), sizeof(float) * params.size());
+  dims_ = ReadOnlyBuffer(context, dims.data(), sizeof(int) * dims.size());
   if (cost == StereoCost::kOrientation) {
-    sources_ = Upload(context, all_sources.data(), sizeof(float) * all_sources.size());
+    sources_ = ReadOnlyBuffer(context, all_sources.data(), sizeof(float) * all_sources.size());
     orientation_kernel_ = cl::Kernel(CostProgram(context), "orientation_cost");
     const FloatMap& gradient = ref.log_depth_gradient;
     has_gradient_ = gradient.Empty() ? 0 : 1;
@@ -102,9 +98,10 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
       CHECK_EQ(gradient.Channels(), 2);
     }
     const float unused[2] = {0, 0};
-    log_depth_gradient_ = has_gradient_ ? Upload(context, gradient.Data().data(),
-                                                 sizeof(float) * gradient.Data().size())
-                                        : Upload(context, unused, sizeof(unused));
+    log_depth_gradient_ = has_gradient_
+                              ? ReadOnlyBuffer(context, gradient.Data().data(),
+                                               sizeof(float) * gradient.Data().size())
+                              : ReadOnlyBuffer(context, unused, sizeof(unused));
   } else {
     box_ = std::make_unique<BoxFilterCL>(context);
     warp_kernel_ = cl::Kernel(CostProgram(context), "photometric_warp");
@@ -121,7 +118,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
       }
       planes[3 * n + p] = sq;
     }
-    cl::Buffer in = Upload(context, planes.data(), sizeof(float) * planes.size());
+    cl::Buffer in = ReadOnlyBuffer(context, planes.data(), sizeof(float) * planes.size());
     cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
     ref_stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
     box_->Mean(in, scratch, ref_stats_, width_, height_, 4, ncc_radius_);
@@ -202,7 +199,7 @@ void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_
 FloatMap CostVolumeCL::Compute(const std::vector<float>& label_base, float label_step,
                                int slice_begin, int num_slices, const DepthLabels& labels) {
   CHECK_EQ(label_base.size(), static_cast<size_t>(width_) * height_);
-  cl::Buffer base = Upload(context_, label_base.data(), sizeof(float) * label_base.size());
+  cl::Buffer base = ReadOnlyBuffer(context_, label_base.data(), sizeof(float) * label_base.size());
   FloatMap out(width_, height_, num_slices);
   cl::Buffer buffer(context_->Context(), CL_MEM_READ_WRITE, sizeof(float) * out.Data().size());
   Compute(base, label_step, slice_begin, num_slices, labels, buffer);

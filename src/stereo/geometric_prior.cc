@@ -24,12 +24,8 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
                              static_cast<int>(maps.size()), 0});
     maps.insert(maps.end(), view->depth.Data().begin(), view->depth.Data().end());
   }
-  maps.resize(std::max<size_t>(maps.size(), 1));
-  dims.resize(std::max<size_t>(dims.size(), 4));
-  depth_maps_ = cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                           sizeof(float) * maps.size(), maps.data());
-  view_dims_ = cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                          sizeof(int) * dims.size(), dims.data());
+  depth_maps_ = ReadOnlyBuffer(context, maps.data(), sizeof(float) * maps.size());
+  view_dims_ = ReadOnlyBuffer(context, dims.data(), sizeof(int) * dims.size());
 }
 
 void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per_grid_px,
@@ -60,17 +56,15 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
     for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(view.K(i / 3, i % 3)));
     for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(centre(i)));
   }
-  cl::Context& cl_context = context_->Context();
-  auto upload = [&](const float* data, size_t count) {
-    return cl::Buffer(cl_context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                      sizeof(float) * std::max<size_t>(count, 1), const_cast<float*>(data));
-  };
   const float no_base = 0.0f;
-  cl::Buffer ref_buffer = upload(ref_params.data(), ref_params.size());
-  cl::Buffer params_buffer = upload(view_params.data(), view_params.size());
-  cl::Buffer base_buffer = base.empty() ? upload(&no_base, 1) : upload(base.data(), n);
+  cl::Buffer ref_buffer =
+      ReadOnlyBuffer(context_, ref_params.data(), sizeof(float) * ref_params.size());
+  cl::Buffer params_buffer =
+      ReadOnlyBuffer(context_, view_params.data(), sizeof(float) * view_params.size());
+  cl::Buffer base_buffer = base.empty() ? ReadOnlyBuffer(context_, &no_base, sizeof(float))
+                                        : ReadOnlyBuffer(context_, base.data(), sizeof(float) * n);
   // The host volume itself (a CPU device adds in place; another copies it there and back).
-  cl::Buffer volume_buffer(cl_context, CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
+  cl::Buffer volume_buffer(context_->Context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
                            sizeof(float) * volume->size(), volume->data());
   const float per_view =
       static_cast<float>(weight_ * cost_scale / num_views_);

@@ -23,8 +23,9 @@ StereoCamera CameraOf(const FusionView& view) {
   return camera;
 }
 
-// The prior uses the consistency filter's forward-backward error: 0 at the depth the other views' maps agree with, the most where they disagree by the maximum
-// error or do not see the point.
+// The prior uses the consistency filter's forward-backward error: 0 at the depth the other
+// views' maps agree with, the most where they disagree by the maximum error or do not see the
+// point.
 TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
   auto context = OpenCLContext::Create();
   const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
