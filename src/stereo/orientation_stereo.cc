@@ -602,7 +602,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     std::map<std::string, FusionView> latest;
     // The last round's estimates, filtered against the maps their prior came from.
     struct FilteredMap {
-      FusionView view;
+      FloatMap depth;
+      Eigen::Matrix3d K;
       ConsistencyFilterStats stats;
     };
     std::map<std::string, FilteredMap> final_maps;
@@ -693,17 +694,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       round_progress.Finish();
       ++result.geometric_rounds;
+      // Only the filtered depths: the unfiltered estimates are the next round's prior.
       std::map<std::string, FilteredMap> filtered;
       ConsistencyFilterStats total;
       {
         ScopedStageTimer timer(timings, "consistency");
         for (const auto& [name, estimate] : next) {
           FilteredMap& map = filtered[name];
-          map.view = estimate;
-          map.view.depth = FilterDepthMapByConsistency(estimate, maps_of(name).sources,
-                                                       options.geom_consistency_max_error_px,
-                                                       options.geom_consistency_min_views,
-                                                       &map.stats);
+          map.depth = FilterDepthMapByConsistency(estimate, maps_of(name).sources,
+                                                  options.geom_consistency_max_error_px,
+                                                  options.geom_consistency_min_views, &map.stats);
+          map.K = estimate.K;
           total.num_checked += map.stats.num_checked;
           total.num_kept += map.stats.num_kept;
         }
@@ -737,17 +738,21 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       filter_progress.Start(static_cast<int>(i), name);
       const ViewMaps maps = maps_of(name);
       const std::vector<const FusionView*>& others = maps.sources;
-      FusionView estimate = *maps.ref;
       const auto estimated_again = final_maps.find(name);
-      if (estimated_again != final_maps.end()) {
-        estimate = std::move(estimated_again->second.view);  // filtered in its round
-        const ConsistencyFilterStats& stats = estimated_again->second.stats;
-        std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
-                    stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
+      FloatMap depth;  // the .geometric map
+      Eigen::Matrix3d K = maps.ref->K;
+      ConsistencyFilterStats stats;  // of the filter that made it
+      bool filtered = true;
+      if (estimated_again != final_maps.end()) {  // filtered in its round
+        depth = std::move(estimated_again->second.depth);
+        K = estimated_again->second.K;
+        stats = estimated_again->second.stats;
       } else if (others.empty()) {
         LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
                      << ".geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+        depth = maps.ref->depth;
+        filtered = false;
       } else {
         if (max_rounds > 0 && others.size() < maps.num_sources) {
           LOG(WARNING) << name << ": " << others.size() << " of its " << maps.num_sources
@@ -756,15 +761,15 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                        << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
         }
         ScopedStageTimer timer(timings, "consistency");
-        ConsistencyFilterStats stats;
-        estimate.depth = FilterDepthMapByConsistency(estimate, others,
-                                                     options.geom_consistency_max_error_px,
-                                                     options.geom_consistency_min_views, &stats);
+        depth = FilterDepthMapByConsistency(*maps.ref, others,
+                                            options.geom_consistency_max_error_px,
+                                            options.geom_consistency_min_views, &stats);
+      }
+      if (filtered) {
         std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
                     stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
       }
-      WriteDepthAndNormals(workspace, name, "geometric", estimate.depth, estimate.K,
-                           options.write_png);
+      WriteDepthAndNormals(workspace, name, "geometric", depth, K, options.write_png);
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
       ++result.num_views;
     }
