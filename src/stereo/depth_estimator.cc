@@ -348,6 +348,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     queue.finish();
   }
   ResampleAccumulateCL resample(context);
+  SumBestSourcesCL select(context);  // best_source_fraction < 1
 
   // The aggregated data term summed over levels on the grid of `grid_level`:
   // [label][row][col] for num_labels labels v = base_l(p) + k * step.
@@ -410,7 +411,6 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     if (select_sources) {
       // Each term's sources lie together in `costs` (one term after the other).
       ScopedStageTimer timer(timings, "source selection");
-      SumBestSourcesCL select(context);
       for (size_t first = 0; first < num_costs;) {
         size_t end = first;
         while (end < num_costs && costs[end].term == costs[first].term) ++end;
