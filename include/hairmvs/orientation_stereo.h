@@ -244,9 +244,9 @@ struct OrientationStereoOptions {
   // covered, median 4.58 -> 4.47 mm, mean 9.89 -> 9.65, 3D median 0.575 -> 0.559 mm, the
   // depths' layer 27 -> 29%, 161 -> 295 s; synth_handheld 93.4 -> 92.8%, 5.61 -> 5.57 mm, 3D
   // median 0.647 -> 0.658 mm, 117 -> 262 s (0.67, 4 of 6: 92.9%, 5.51 mm, 3D median 0.655 mm,
-  // 252 s); the curly demo 2.37 -> 2.38 mm. Hence not the
-  // default. Selecting in the fine band only (the coarse stage summing every source) keeps less
-  // of the gain for less time: the gantry 4.51 mm in 218 s, the handheld 5.62 mm in 179 s.
+  // 252 s); the curly demo 2.37 -> 2.38 mm. Hence not the default. Selecting in the fine band
+  // only (the coarse stage summing every source) keeps less of the gain for less time: the
+  // gantry 4.51 mm in 218 s, the handheld 5.62 mm in 179 s.
   double best_source_fraction = 1.0;
   // Geometric consistency, as COLMAP's patch_match_stereo names its passes: each view's depth
   // map as first estimated is written as depth_maps/<name>.photometric.bin. The geometric pass
