@@ -111,10 +111,10 @@ std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int ite
   cl::Program& program = context->Program({"mrf_bp.cl"}, options);
   cl::Kernel colour_kernel(program, "bp_colour");
   cl::Kernel labels_kernel(program, "bp_labels");
-  cl::Buffer cost_buffer = MrfReadOnlyBuffer(ctx, problem.data_cost);
-  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
-  cl::Buffer right_buffer = MrfReadOnlyBuffer(ctx, weight_right);
-  cl::Buffer down_buffer = MrfReadOnlyBuffer(ctx, weight_down);
+  cl::Buffer cost_buffer = ReadOnlyBuffer(context, problem.data_cost);
+  cl::Buffer offset_buffer = ReadOnlyBuffer(context, offset);
+  cl::Buffer right_buffer = ReadOnlyBuffer(context, weight_right);
+  cl::Buffer down_buffer = ReadOnlyBuffer(context, weight_down);
   const size_t msg_bytes = 4 * n * num_labels * sizeof(float);
   cl::Buffer msg_buffer(ctx, CL_MEM_READ_WRITE, msg_bytes);
   cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));

@@ -6,11 +6,6 @@
 
 namespace hairmvs {
 
-cl::Buffer MrfReadOnlyBuffer(cl::Context& context, const std::vector<float>& host) {
-  return cl::Buffer(context, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, host.size() * sizeof(float),
-                    const_cast<float*>(host.data()));
-}
-
 std::vector<int> MrfReadLabels(cl::CommandQueue& queue, const cl::Buffer& labels, size_t n) {
   std::vector<int> host(n);
   queue.enqueueReadBuffer(labels, CL_TRUE, 0, n * sizeof(int), host.data());

@@ -19,9 +19,6 @@ inline cl::NDRange MrfGlobalRange(size_t count) {
   return cl::NDRange((count + kMrfLocalSize - 1) / kMrfLocalSize * kMrfLocalSize);
 }
 
-// A read-only device copy of `host`.
-cl::Buffer MrfReadOnlyBuffer(cl::Context& context, const std::vector<float>& host);
-
 // Blocks until the queue is done and returns the n labels of `labels`.
 std::vector<int> MrfReadLabels(cl::CommandQueue& queue, const cl::Buffer& labels, size_t n);
 

@@ -217,7 +217,7 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
   cl::CommandQueue& queue = context->Queue();
   cl::Program& program =
       context->Program({"mrf_sgm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
-  cl::Buffer offset_buffer = MrfReadOnlyBuffer(ctx, offset);
+  cl::Buffer offset_buffer = ReadOnlyBuffer(context, offset);
   cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
   // Each direction's weight buffer stays alive until the queue has finished with it; [0] and
   // [2], directions (1, 0) and (0, 1), are weights.right and .down, which ICM reads too.
@@ -242,7 +242,7 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
     for (const auto& dir : SemiGlobalDirections(num_directions)) {
       const int dx = dir[0];
       const int dy = dir[1];
-      weight_buffers.push_back(MrfReadOnlyBuffer(ctx, DirectionWeights(weights, dx, dy)));
+      weight_buffers.push_back(ReadOnlyBuffer(context, DirectionWeights(weights, dx, dy)));
       const int num_paths = NumPaths(width, height, dx, dy);
       path_kernel.setArg(0, cost_buffer);
       path_kernel.setArg(1, offset_buffer);
@@ -268,7 +268,7 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
   }
 
   if (icm_iterations > 0) {
-    const cl::Buffer label_major_cost = MrfReadOnlyBuffer(ctx, problem.data_cost);
+    const cl::Buffer label_major_cost = ReadOnlyBuffer(context, problem.data_cost);
     RunIcmOpenCL(context, label_major_cost, offset_buffer, weight_buffers[0], weight_buffers[2],
                  problem, icm_iterations, label_buffer);
   }

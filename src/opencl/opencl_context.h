@@ -94,6 +94,11 @@ class OpenCLContext {
 // A read-only device buffer holding a copy of `bytes` bytes at `data` (at least 4 bytes, so that
 // an empty array still gives a valid kernel argument).
 cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes);
+// The same for the elements of a contiguous container (std::vector, std::array).
+template <typename Container>
+cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const Container& host) {
+  return ReadOnlyBuffer(context, host.data(), sizeof(*host.data()) * host.size());
+}
 
 // The text of `file` from the embedded kernels, with `#include "x.clh"` lines replaced by the
 // included file (recursively, each at most once). Throws hairmvs::Error for an unknown file.

@@ -54,7 +54,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
   CHECK_EQ(ref.field.Channels(), expected_channels);
   CHECK_EQ(ref.camera.width, width_);
   CHECK_EQ(ref.camera.height, height_);
-  ref_ = ReadOnlyBuffer(context, ref.field.Data().data(), sizeof(float) * ref.field.Data().size());
+  ref_ = ReadOnlyBuffer(context, ref.field.Data());
   std::vector<float> params;
   std::vector<int> dims;
   std::vector<float> all_sources;
@@ -79,16 +79,14 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     }
     source_sizes_.push_back({src.field.Width(), src.field.Height()});
     if (cost == StereoCost::kPhotometric) {
-      source_buffers_.push_back(ReadOnlyBuffer(context, src.field.Data().data(),
-                                               sizeof(float) * src.field.Data().size()));
-      source_params_.push_back(
-          ReadOnlyBuffer(context, packed.data(), sizeof(float) * packed.size()));
+      source_buffers_.push_back(ReadOnlyBuffer(context, src.field.Data()));
+      source_params_.push_back(ReadOnlyBuffer(context, packed));
     }
   }
-  params_ = ReadOnlyBuffer(context, params.data(), sizeof(float) * params.size());
-  dims_ = ReadOnlyBuffer(context, dims.data(), sizeof(int) * dims.size());
+  params_ = ReadOnlyBuffer(context, params);
+  dims_ = ReadOnlyBuffer(context, dims);
   if (cost == StereoCost::kOrientation) {
-    sources_ = ReadOnlyBuffer(context, all_sources.data(), sizeof(float) * all_sources.size());
+    sources_ = ReadOnlyBuffer(context, all_sources);
     orientation_kernel_ = cl::Kernel(CostProgram(context), "orientation_cost");
     const FloatMap& gradient = ref.log_depth_gradient;
     has_gradient_ = gradient.Empty() ? 0 : 1;
@@ -99,8 +97,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     }
     const float unused[2] = {0, 0};
     log_depth_gradient_ = has_gradient_
-                              ? ReadOnlyBuffer(context, gradient.Data().data(),
-                                               sizeof(float) * gradient.Data().size())
+                              ? ReadOnlyBuffer(context, gradient.Data())
                               : ReadOnlyBuffer(context, unused, sizeof(unused));
   } else {
     box_ = std::make_unique<BoxFilterCL>(context);
@@ -118,7 +115,7 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
       }
       planes[3 * n + p] = sq;
     }
-    cl::Buffer in = ReadOnlyBuffer(context, planes.data(), sizeof(float) * planes.size());
+    cl::Buffer in = ReadOnlyBuffer(context, planes);
     cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
     ref_stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
     box_->Mean(in, scratch, ref_stats_, width_, height_, 4, ncc_radius_);
@@ -199,7 +196,7 @@ void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_
 FloatMap CostVolumeCL::Compute(const std::vector<float>& label_base, float label_step,
                                int slice_begin, int num_slices, const DepthLabels& labels) {
   CHECK_EQ(label_base.size(), static_cast<size_t>(width_) * height_);
-  cl::Buffer base = ReadOnlyBuffer(context_, label_base.data(), sizeof(float) * label_base.size());
+  cl::Buffer base = ReadOnlyBuffer(context_, label_base);
   FloatMap out(width_, height_, num_slices);
   cl::Buffer buffer(context_->Context(), CL_MEM_READ_WRITE, sizeof(float) * out.Data().size());
   Compute(base, label_step, slice_begin, num_slices, labels, buffer);

@@ -24,8 +24,8 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
                              static_cast<int>(maps.size()), 0});
     maps.insert(maps.end(), view->depth.Data().begin(), view->depth.Data().end());
   }
-  depth_maps_ = ReadOnlyBuffer(context, maps.data(), sizeof(float) * maps.size());
-  view_dims_ = ReadOnlyBuffer(context, dims.data(), sizeof(int) * dims.size());
+  depth_maps_ = ReadOnlyBuffer(context, maps);
+  view_dims_ = ReadOnlyBuffer(context, dims);
 }
 
 void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per_grid_px,
@@ -57,10 +57,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
     for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(centre(i)));
   }
   const float no_base = 0.0f;
-  cl::Buffer ref_buffer =
-      ReadOnlyBuffer(context_, ref_params.data(), sizeof(float) * ref_params.size());
-  cl::Buffer params_buffer =
-      ReadOnlyBuffer(context_, view_params.data(), sizeof(float) * view_params.size());
+  cl::Buffer ref_buffer = ReadOnlyBuffer(context_, ref_params);
+  cl::Buffer params_buffer = ReadOnlyBuffer(context_, view_params);
   cl::Buffer base_buffer = base.empty() ? ReadOnlyBuffer(context_, &no_base, sizeof(float))
                                         : ReadOnlyBuffer(context_, base.data(), sizeof(float) * n);
   // The host volume itself (a CPU device adds in place; another copies it there and back).
