@@ -433,6 +433,21 @@ DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
   return ComputeDepthRange(model, image_id);
 }
 
+std::vector<std::string> ViewsLookingTheSameWay(const Workspace& ws, const std::string& reference,
+                                                const std::vector<std::string>& exclude,
+                                                double max_view_angle_deg) {
+  const Eigen::Vector3d direction = ws.ImageByName(reference).ViewingDirection();
+  const double min_cos = std::cos(max_view_angle_deg * kPi / 180.0);
+  std::vector<std::string> views;
+  for (const std::string& name : ws.ImageNames()) {
+    if (name == reference || std::find(exclude.begin(), exclude.end(), name) != exclude.end()) {
+      continue;
+    }
+    if (direction.dot(ws.ImageByName(name).ViewingDirection()) >= min_cos) views.push_back(name);
+  }
+  return views;
+}
+
 DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,
                          const SourceViewOptions& options) {
   if (options.depth_min > 0 && options.depth_max > 0) {

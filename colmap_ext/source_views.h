@@ -98,6 +98,15 @@ struct SourceViewSelection {
 std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
                                                    const SourceViewOptions& options);
 
+// The views of the workspace, other than `reference` and those in `exclude`, whose viewing
+// direction is within max_view_angle_deg of the reference's, in image_idx order. The geometric
+// pass checks a depth map against these besides its sources: consistency needs only that a view
+// sees the same side of the hair, not that it looks alike, so it can use the wider baselines
+// that orientation matching cannot (a gantry's neighbouring T groups, 35-60 degrees away).
+std::vector<std::string> ViewsLookingTheSameWay(const Workspace& ws, const std::string& reference,
+                                                const std::vector<std::string>& exclude,
+                                                double max_view_angle_deg);
+
 struct DepthRange {
   double min_m = -1;
   double max_m = -1;

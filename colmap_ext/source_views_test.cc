@@ -194,6 +194,33 @@ TEST(SourceViews, EpipolarDirection) {
   EXPECT_NEAR(EpipolarDirectionRad(model, 1, 4, Eigen::Vector2d(42, 34)), M_PI / 4, 1e-9);
 }
 
+TEST(SourceViews, ViewsLookingTheSameWayAreWithinTheAngleOfTheReferencesAxis) {
+  // Five views on a ring around the origin, turned about the vertical (camera y) axis by 0,
+  // 20, 45, 60 and 120 degrees, all looking at the centre.
+  const std::vector<double> turns_deg = {0, 20, 45, 60, 120};
+  const std::vector<std::string> names = {"a.png", "b.png", "c.png", "d.png", "e.png"};
+  Reconstruction model =
+      MakeRig(std::vector<Eigen::Vector3d>(5, Eigen::Vector3d::Zero()), names, {31});
+  for (auto& [id, image] : model.images) {
+    image.cam_from_world_rotation = Eigen::Quaterniond(
+        Eigen::AngleAxisd(turns_deg[id - 1] * M_PI / 180, Eigen::Vector3d::UnitY()));
+    image.cam_from_world_translation = Eigen::Vector3d(0, 0, 1);  // the centre 1 m ahead
+  }
+  const Workspace ws = WriteAndRead("same_way", model);
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 50),
+            (std::vector<std::string>{"b.png", "c.png"}));
+  // The angle is between the viewing directions, whichever way they turn: from d, a and e
+  // are both 60 degrees away.
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "d.png", {}, 50),
+            (std::vector<std::string>{"b.png", "c.png"}));
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "d.png", {}, 65),
+            (std::vector<std::string>{"a.png", "b.png", "c.png", "e.png"}));
+  // Views already chosen (the sources) are not repeated.
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {"b.png"}, 50), (std::vector<std::string>{"c.png"}));
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 10), (std::vector<std::string>{}));
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 180).size(), 4u);
+}
+
 TEST(DepthRange, ColmapRuleAndOverrides) {
   Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}}, {"a.png", "b.png"}, {});
   for (int k = 1; k <= 100; ++k) {

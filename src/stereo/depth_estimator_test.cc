@@ -235,8 +235,8 @@ void ExpectRefusedNaming(const OrientationStereoOptions& options, const std::str
 }
 
 // The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) and a
-// photometric weight outside [0, 1] and fewer than one round of the geometric pass are refused
-// by name. The strands' plane follows the hull
+// photometric weight outside [0, 1], fewer than one round of the geometric pass and a view angle
+// outside [0, 180] degrees are refused by name. The strands' plane follows the hull
 // only for the costs that match orientations, through the plane homography.
 TEST(OrientationStereoOptions, StrandPlaneOptions) {
   OrientationStereoOptions options;
@@ -269,6 +269,11 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   options = OrientationStereoOptions();
   options.geom_consistency_min_gain = -2;
   ExpectRefusedNaming(options, "geom_consistency_min_gain");
+  for (double angle : {-1.0, 181.0}) {
+    options = OrientationStereoOptions();
+    options.geom_consistency_max_view_angle_deg = angle;
+    ExpectRefusedNaming(options, "geom_consistency_max_view_angle_deg");
+  }
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());

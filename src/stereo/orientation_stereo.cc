@@ -13,6 +13,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <set>
 #include <sstream>
 
 #include "colmap_ext/mat_io.h"
@@ -136,6 +137,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
   if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
   if (geom_consistency_iterations < 1) e << "geom_consistency_iterations must be >= 1; ";
+  if (!(geom_consistency_max_view_angle_deg >= 0 && geom_consistency_max_view_angle_deg <= 180)) {
+    e << "geom_consistency_max_view_angle_deg must be in [0, 180]; ";
+  }
   if (!(geom_consistency_min_inconsistent_fraction >= 0 &&
         geom_consistency_min_inconsistent_fraction <= 1)) {
     e << "geom_consistency_min_inconsistent_fraction must be in [0, 1]; ";
@@ -591,7 +595,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
   if (options.geom_consistency) {
     // The geometric pass: every view estimated now (or, with geom_consistency_only, every
-    // requested view) is estimated again with its sources' maps as a prior, in rounds (each
+    // requested view) is estimated again with its sources' maps (and those of the views
+    // looking the same way, below) as a prior, in rounds (each
     // from the previous round's maps of every view, the .photometric ones first, so that the
     // order of the views does not matter), and its final map filtered by consistency with the
     // maps its prior came from (as COLMAP's geometric pass filters against the maps it reads:
@@ -607,6 +612,21 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       ConsistencyFilterStats stats;
     };
     std::map<std::string, FilteredMap> final_maps;
+    // The views whose maps a view's prior and filter read: its sources and, within
+    // geom_consistency_max_view_angle_deg, the other views of this run looking the same way
+    // (of this run: so that a job of an array, given its own views, reads no map that another
+    // job may or may not have written yet).
+    std::map<std::string, std::vector<std::string>> consistency_views_of = sources_of;
+    if (options.geom_consistency_max_view_angle_deg > 0) {
+      const std::set<std::string> in_run(names.begin(), names.end());
+      for (const std::string& name : to_filter) {
+        std::vector<std::string>& views = consistency_views_of[name];
+        for (std::string& other : ViewsLookingTheSameWay(
+                 workspace, name, views, options.geom_consistency_max_view_angle_deg)) {
+          if (in_run.count(other) > 0) views.push_back(std::move(other));
+        }
+      }
+    }
     auto load = [&](const std::string& name) -> const FusionView* {
       auto it = latest.find(name);
       if (it == latest.end()) {
@@ -626,11 +646,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
       return it->second.depth.Empty() ? nullptr : &it->second;
     };
-    // A view's latest map and those of its sources that have one (of num_sources).
+    // A view's latest map and those of the views it is checked against that have one (of
+    // num_others).
     struct ViewMaps {
       const FusionView* ref = nullptr;
-      std::vector<const FusionView*> sources;
-      size_t num_sources = 0;
+      std::vector<const FusionView*> others;
+      size_t num_others = 0;
     };
     auto maps_of = [&](const std::string& name) {
       ViewMaps maps;
@@ -638,11 +659,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       THROW_IF(maps.ref == nullptr, workspace.DepthMapPath(name, "photometric")
                                         << ": missing; run orientation_stereo on " << name
                                         << " first (without geom_consistency_only)");
-      const auto it = sources_of.find(name);
-      if (it != sources_of.end()) {
-        maps.num_sources = it->second.size();
-        for (const std::string& source : it->second) {
-          if (const FusionView* view = load(source)) maps.sources.push_back(view);
+      const auto it = consistency_views_of.find(name);
+      if (it != consistency_views_of.end()) {
+        maps.num_others = it->second.size();
+        for (const std::string& other : it->second) {
+          if (const FusionView* view = load(other)) maps.others.push_back(view);
         }
       }
       return maps;
@@ -666,12 +687,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         const std::string& name = to_filter[i];
         round_progress.Start(static_cast<int>(i), name);
         const ViewMaps maps = maps_of(name);
-        // Without all of its sources' maps (a job array's other jobs), the prior would depend
-        // on which are done: such a view is only filtered (the filter below says so).
-        if (maps.sources.empty() || maps.sources.size() < maps.num_sources) continue;
-        // COLMAP's geometric pass: estimated again with the sources' maps as a prior.
+        // Without all of those maps (a job array's other jobs), the prior would depend on which
+        // are done: such a view is only filtered (the filter below says so).
+        if (maps.others.empty() || maps.others.size() < maps.num_others) continue;
+        // COLMAP's geometric pass: estimated again with those maps as a prior.
         GeometricPrior prior;
-        prior.views = maps.sources;
+        prior.views = maps.others;
         prior.weight = options.geom_prior_weight;
         prior.max_error_px = options.geom_prior_max_error_px;
         const auto cached = first_estimates.find(name);
@@ -701,7 +722,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         ScopedStageTimer timer(timings, "consistency");
         for (const auto& [name, estimate] : next) {
           FilteredMap& map = filtered[name];
-          map.depth = FilterDepthMapByConsistency(estimate, maps_of(name).sources,
+          map.depth = FilterDepthMapByConsistency(estimate, maps_of(name).others,
                                                   options.geom_consistency_max_error_px,
                                                   options.geom_consistency_min_views, &map.stats);
           map.K = estimate.K;
@@ -737,7 +758,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       const std::string& name = to_filter[i];
       filter_progress.Start(static_cast<int>(i), name);
       const ViewMaps maps = maps_of(name);
-      const std::vector<const FusionView*>& others = maps.sources;
+      const std::vector<const FusionView*>& others = maps.others;
       const auto estimated_again = final_maps.find(name);
       FloatMap depth;  // the .geometric map
       Eigen::Matrix3d K = maps.ref->K;
@@ -748,16 +769,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         K = estimated_again->second.K;
         stats = estimated_again->second.stats;
       } else if (others.empty()) {
-        LOG(WARNING) << name << ": no source view has a .photometric depth map yet; its "
-                     << ".geometric map is unfiltered (run again with "
-                     << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+        LOG(WARNING) << name << ": no view it is checked against (its sources) has a "
+                     << ".photometric depth map yet; its .geometric map is unfiltered (run "
+                     << "again with --OrientationStereo.geom_consistency_only 1 when all views "
+                     << "are done)";
         depth = maps.ref->depth;
         filtered = false;
       } else {
-        if (max_rounds > 0 && others.size() < maps.num_sources) {
-          LOG(WARNING) << name << ": " << others.size() << " of its " << maps.num_sources
-                       << " source views have a .photometric depth map yet; its .geometric map "
-                       << "is only filtered (run again with "
+        if (max_rounds > 0 && others.size() < maps.num_others) {
+          LOG(WARNING) << name << ": " << others.size() << " of the " << maps.num_others
+                       << " views it is checked against have a .photometric depth map yet; its "
+                       << ".geometric map is only filtered (run again with "
                        << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
         }
         ScopedStageTimer timer(timings, "consistency");
@@ -766,8 +788,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                             options.geom_consistency_min_views, &stats);
       }
       if (filtered) {
-        std::printf("  %s: %d of %d depths consistent with %d source view(s)\n", name.c_str(),
-                    stats.num_kept, stats.num_checked, static_cast<int>(others.size()));
+        std::printf("  %s: %d of %d depths consistent with the maps of %d other view(s)\n",
+                    name.c_str(), stats.num_kept, stats.num_checked,
+                    static_cast<int>(others.size()));
       }
       WriteDepthAndNormals(workspace, name, "geometric", depth, K, options.write_png);
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));

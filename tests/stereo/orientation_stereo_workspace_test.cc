@@ -394,5 +394,46 @@ TEST(OrientationStereoWorkspace, RoundsStopWhereTheMapsAgree) {
   std::filesystem::remove_all(path);
 }
 
+// The geometric pass also reads the maps of the run's other views within
+// geom_consistency_max_view_angle_deg (the views of WriteWorkspace are 17 degrees apart).
+TEST(OrientationStereoWorkspace, GeometricPassAlsoReadsTheViewsLookingTheSameWay) {
+  const std::string path = MakeTestDir("stereo_same_way");
+  WriteWorkspace(path);
+  {  // v0 is matched against v1 alone.
+    std::ofstream cfg(JoinPaths(path, "stereo", "patch-match.cfg"));
+    cfg << "v0.png\nv1.png\nv1.png\nv0.png, v2.png, v3.png\nv2.png\nv0.png, v1.png, v3.png\n"
+        << "v3.png\nv0.png, v1.png, v2.png\n";
+  }
+  const Workspace workspace = Workspace::Read(path);
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_prior_weight = 0;  // the filter alone, whose counts tell which maps it read
+  options.geom_consistency_min_views = 2;
+  options.geom_consistency_max_view_angle_deg = 0;  // the sources only
+  StageTimings timings;
+  ASSERT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  auto num_kept = [&](const std::string& name) {
+    const FloatMap map = ReadMat(workspace.DepthMapPath(name, "geometric"));
+    return std::count_if(map.Data().begin(), map.Data().end(), [](float d) { return d > 0; });
+  };
+  // With one source, no depth of v0 can have two views agreeing with it.
+  EXPECT_EQ(num_kept("v0.png"), 0);
+  const long v1_kept = num_kept("v1.png");
+  EXPECT_GT(v1_kept, 96 * 72 / 2);
+
+  options.geom_consistency_only = true;
+  options.geom_consistency_max_view_angle_deg = 20;
+  RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_GT(num_kept("v0.png"), 96 * 72 / 2);
+  EXPECT_EQ(num_kept("v1.png"), v1_kept);  // its sources are all the others already
+  // Only the views of the run: v0 alone reads no other map than its source's.
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  EXPECT_EQ(num_kept("v0.png"), 0);
+  // Views beyond the angle are not read.
+  options.geom_consistency_max_view_angle_deg = 10;
+  RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_EQ(num_kept("v0.png"), 0);
+  std::filesystem::remove_all(path);
+}
+
 }  // namespace
 }  // namespace hairmvs
