@@ -1,5 +1,6 @@
 // The geometric pass's prior (src/stereo/geometric_prior.h): for pixel p of the reference's grid
-// and label v = (has_base ? label_base[p] : 0) + k * label_step, at depth D(v),
+// and label v = (has_base ? label_base[p] : 0) + k * label_step, at depth D(v), where
+// (has_active ? active[p] : 1) is non-zero,
 //   volume[k][p] += per_view_weight * sum_j min(e_j, max_error_px) / max_error_px,
 // e_j COLMAP's forward-backward reprojection error through view j's depth map (in level-0
 // pixels: the grid's error times level0_px_per_grid_px), max_error_px where view j does not see
@@ -23,7 +24,8 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
                               __global const float* depth_maps,
                               __global const float* view_params,
                               __global const int* view_dims, int num_views,
-                              __global const float* label_base, int has_base, float label_step,
+                              __global const float* label_base, int has_base,
+                              __global const uchar* active, int has_active, float label_step,
                               float depth_a, float depth_b, int inverse_depth,
                               float max_error_px, float level0_px_per_grid_px,
                               float per_view_weight, __global float* volume) {
@@ -32,6 +34,7 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
   const int k = get_global_id(2);
   if (col >= width || row >= height) return;
   const int p = row * width + col;
+  if (has_active && !active[p]) return;
   const float v = (has_base ? label_base[p] : 0.0f) + (float)k * label_step;
   const float t = depth_a + depth_b * v;
   const float depth = inverse_depth ? 1.0f / t : t;

@@ -503,12 +503,30 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   }
   float prior_scale = 0;
   std::optional<GeometricPriorCL> prior_cl;  // the views' maps on the device, for both stages
+  // Where the prior is added: the mask's pixels, and on the coarse grid every block with one.
+  std::vector<uint8_t> prior_active0, prior_active_coarse;
   if (use_prior) {
     ScopedStageTimer timer(timings, "geometric prior");
+    if (!mask.Empty()) {
+      CHECK_EQ(mask.Width(), width0);
+      CHECK_EQ(mask.Height(), height0);
+      const int factor = 1 << coarse_level;
+      prior_active0.resize(static_cast<size_t>(width0) * height0);
+      prior_active_coarse.assign(static_cast<size_t>(cw) * ch, 0);
+      for (int row = 0; row < height0; ++row) {
+        for (int col = 0; col < width0; ++col) {
+          const bool inside = mask.At(row, col) > 0.5f;
+          prior_active0[static_cast<size_t>(row) * width0 + col] = inside;
+          const int r = std::min(row / factor, ch - 1), c = std::min(col / factor, cw - 1);
+          prior_active_coarse[static_cast<size_t>(r) * cw + c] |= inside;
+        }
+      }
+    }
     prior_scale = MedianCostRange(coarse_volume, static_cast<size_t>(cw) * ch, num_depths);
     prior_cl.emplace(context, *prior);
     prior_cl->Add(ref.camera.PyramidLevel(coarse_level), LevelPixelsPerPixel(0, coarse_level),
-                  labels, coarse_grid_base, 1.0f, num_depths, prior_scale, &coarse_volume);
+                  labels, coarse_grid_base, 1.0f, num_depths, prior_active_coarse, prior_scale,
+                  &coarse_volume);
   }
   if (penalize) {
     // On the coarse grid, the smallest bound of each block, so that it never excludes what a
@@ -584,7 +602,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     if (use_prior) {
       ScopedStageTimer timer(timings, "geometric prior");
       prior_cl->Add(ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step, band,
-                    prior_scale, &fine_volume);
+                    prior_active0, prior_scale, &fine_volume);
     }
     if (penalize) {
       PenalizeInFrontOfBound(bound0, base[0], step, band, &fine_volume);

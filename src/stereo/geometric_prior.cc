@@ -30,13 +30,14 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
 
 void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per_grid_px,
                            const DepthLabels& labels, const std::vector<float>& base,
-                           float step, int num_labels, float cost_scale,
-                           std::vector<float>* volume) {
+                           float step, int num_labels, const std::vector<uint8_t>& active,
+                           float cost_scale, std::vector<float>* volume) {
   if (num_views_ == 0 || !(weight_ > 0) || num_labels < 1) return;
   const int width = grid_camera.width, height = grid_camera.height;
   const size_t n = static_cast<size_t>(width) * height;
   CHECK_EQ(volume->size(), n * num_labels);
   CHECK(base.empty() || base.size() == n);
+  CHECK(active.empty() || active.size() == n);
   // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
   // precision keeps the errors to about 1e-4 px.
   const Eigen::Matrix3d R_t = grid_camera.R.transpose();
@@ -57,10 +58,13 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
     for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(centre(i)));
   }
   const float no_base = 0.0f;
+  const uint8_t all_active = 1;
   cl::Buffer ref_buffer = ReadOnlyBuffer(context_, ref_params);
   cl::Buffer params_buffer = ReadOnlyBuffer(context_, view_params);
   cl::Buffer base_buffer = base.empty() ? ReadOnlyBuffer(context_, &no_base, sizeof(float))
                                         : ReadOnlyBuffer(context_, base.data(), sizeof(float) * n);
+  cl::Buffer active_buffer = active.empty() ? ReadOnlyBuffer(context_, &all_active, 1)
+                                            : ReadOnlyBuffer(context_, active);
   // The host volume itself (a CPU device adds in place; another copies it there and back).
   cl::Buffer volume_buffer(context_->Context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
                            sizeof(float) * volume->size(), volume->data());
@@ -77,6 +81,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   k.setArg(arg++, num_views_);
   k.setArg(arg++, base_buffer);
   k.setArg(arg++, base.empty() ? 0 : 1);
+  k.setArg(arg++, active_buffer);
+  k.setArg(arg++, active.empty() ? 0 : 1);
   k.setArg(arg++, step);
   k.setArg(arg++, static_cast<float>(labels.a));
   k.setArg(arg++, static_cast<float>(labels.b));
@@ -97,7 +103,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
 void AddGeometricPriorCpu(const GeometricPrior& prior, const StereoCamera& grid_camera,
                           double level0_px_per_grid_px, const DepthLabels& labels,
                           const std::vector<float>& base, float step, int num_labels,
-                          float cost_scale, std::vector<float>* volume) {
+                          const std::vector<uint8_t>& active, float cost_scale,
+                          std::vector<float>* volume) {
   if (prior.views.empty() || !(prior.weight > 0)) return;
   const int width = grid_camera.width, height = grid_camera.height;
   const size_t n = static_cast<size_t>(width) * height;
@@ -110,6 +117,7 @@ void AddGeometricPriorCpu(const GeometricPrior& prior, const StereoCamera& grid_
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {
       const size_t p = static_cast<size_t>(row) * width + col;
+      if (!active.empty() && active[p] == 0) continue;
       const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
       const Eigen::Vector2d centre(col + 0.5, row + 0.5);
       for (int k = 0; k < num_labels; ++k) {

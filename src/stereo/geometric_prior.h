@@ -8,6 +8,7 @@
 // across the coarse labels, so that weight is relative to the data term whatever its units.
 // On the device (kernels/geometric_prior.cl); AddGeometricPriorCpu is the plain reference.
 
+#include <cstdint>
 #include <vector>
 
 #include "src/fusion/fusion_view.h"
@@ -26,14 +27,18 @@ struct GeometricPrior {
 
 // The prior added to a host volume ([label][row][col] on the grid of `grid_camera`, whose pixels
 // are `level0_px_per_grid_px` level-0 pixels wide) for labels v = base(p) + k * step (base empty
-// = 0), k < num_labels.
+// = 0), k < num_labels, at the pixels where `active` is non-zero (empty: every pixel). Outside the
+// masks the data term is 0 at every label and the depths are not kept: the prior there would
+// be most of the work (a gantry view's mask covers a fifth of it) and would only pull the
+// masks' borders through the smoothness towards whatever the other views see behind them.
 class GeometricPriorCL {
  public:
   // Uploads the views' depth maps (the views need not outlive this object).
   GeometricPriorCL(OpenCLContext* context, const GeometricPrior& prior);
   void Add(const StereoCamera& grid_camera, double level0_px_per_grid_px,
            const DepthLabels& labels, const std::vector<float>& base, float step,
-           int num_labels, float cost_scale, std::vector<float>* volume);
+           int num_labels, const std::vector<uint8_t>& active, float cost_scale,
+           std::vector<float>* volume);
 
  private:
   struct ViewCamera {
@@ -54,6 +59,7 @@ class GeometricPriorCL {
 void AddGeometricPriorCpu(const GeometricPrior& prior, const StereoCamera& grid_camera,
                           double level0_px_per_grid_px, const DepthLabels& labels,
                           const std::vector<float>& base, float step, int num_labels,
-                          float cost_scale, std::vector<float>* volume);
+                          const std::vector<uint8_t>& active, float cost_scale,
+                          std::vector<float>* volume);
 
 }  // namespace hairmvs

@@ -41,7 +41,7 @@ TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
   prior.max_error_px = 3.0;
   std::vector<float> volume(n * labels.num_labels, 0.0f);
   GeometricPriorCL prior_cl(context.get(), prior);
-  prior_cl.Add(camera, 1.0, labels, {}, 1.0f, labels.num_labels, 0.5f, &volume);
+  prior_cl.Add(camera, 1.0, labels, {}, 1.0f, labels.num_labels, {}, 0.5f, &volume);
   int checked = 0;
   for (int row = 0; row < camera.height; ++row) {
     for (int col = 20; col < 60; ++col) {  // the part of the reference the left view sees
@@ -62,12 +62,12 @@ TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
   EXPECT_EQ(checked, 40 * 60);
   // Labels relative to a per-pixel base (the fine band) score the same depths alike.
   std::vector<float> base(n, 10.0f), band(n * 8, 0.0f);
-  prior_cl.Add(camera, 1.0, labels, base, 0.5f, 8, 0.5f, &band);
+  prior_cl.Add(camera, 1.0, labels, base, 0.5f, 8, {}, 0.5f, &band);
   for (int k = 0; k < 8; ++k) {
     const size_t p = 30 * camera.width + 40;
     std::vector<float> single(n, 0.0f);
     const std::vector<float> one_base(n, 10.0f + 0.5f * k);
-    prior_cl.Add(camera, 1.0, labels, one_base, 1.0f, 1, 0.5f, &single);
+    prior_cl.Add(camera, 1.0, labels, one_base, 1.0f, 1, {}, 0.5f, &single);
     EXPECT_NEAR(band[k * n + p], single[p], 1e-6f) << k;
   }
 }
@@ -76,7 +76,7 @@ TEST(GeometricPriorTest, IsLowestAtTheDepthTheOtherMapsAgreeWith) {
 // The kernel against the plain double-precision reference on a coarse grid (2 level-0 pixels per
 // grid pixel) with per-pixel label bases: maps that disagree with the reference by a few pixels
 // (so that errors fall on both sides of max_error_px), holes, and a view that sees only part of
-// the reference.
+// the reference; with the bases, only at the pixels of a mask.
 TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   auto context = OpenCLContext::Create();
   const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
@@ -100,24 +100,37 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   prior.weight = 2.0;
   prior.max_error_px = 6.0;
   const int num_labels = 12;
+  // A mask of the pixels where the prior is added (about two thirds), with the base only.
+  std::vector<uint8_t> active(n);
+  for (uint8_t& a : active) a = unit(rng) < 0.67f;
   for (bool with_base : {true, false}) {
     const std::vector<float> label_base = with_base ? base : std::vector<float>();
+    const std::vector<uint8_t> pixels = with_base ? active : std::vector<uint8_t>();
     const float step = with_base ? 0.75f : 5.0f;  // without a base: labels 0 to 55
     std::vector<float> expected(n * num_labels, 0.25f), got = expected;
-    AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, 0.5f,
+    AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f,
                          &expected);
     GeometricPriorCL(context.get(), prior)
-        .Add(grid, 2.0, labels, label_base, step, num_labels, 0.5f, &got);
+        .Add(grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f, &got);
     // Single precision moves a projection by about 1e-4 px: where that crosses a pixel border
     // of a source map, the two read neighbouring depths (a few entries in a million).
-    size_t close = 0, partial = 0;
+    size_t close = 0, partial = 0, untouched = 0, inactive = 0;
     for (size_t i = 0; i < got.size(); ++i) {
       if (std::abs(got[i] - expected[i]) < 1e-4f) ++close;
       // Neither all views at 0 nor all at the maximum: the entry measures real errors.
       if (expected[i] > 0.26f && expected[i] < 1.24f) ++partial;
+      if (!pixels.empty() && pixels[i % n] == 0) {
+        ++inactive;
+        untouched += got[i] == 0.25f && expected[i] == 0.25f;
+      }
     }
     EXPECT_GE(close, got.size() - got.size() / 1000) << with_base;
-    EXPECT_GT(partial, got.size() / 4) << with_base;
+    EXPECT_GT(partial, got.size() / 5) << with_base;
+    // Nothing added outside the mask.
+    EXPECT_EQ(untouched, inactive) << with_base;
+    if (with_base) {
+      EXPECT_GT(inactive, got.size() / 5);
+    }
   }
 }
 
