@@ -334,6 +334,13 @@ struct OrientationStereoOptions {
   double geom_consistency_max_view_angle_deg = 90.0;
   double geom_consistency_min_inconsistent_fraction = 0.1;
   double geom_consistency_min_gain = 0.01;
+  // Estimate on the part of the view that holds its mask (the bounding box, grown past every
+  // window's reach and aligned to the pyramid) rather than on the whole image: outside the
+  // mask the data term is 0 and no depth is kept, yet the aggregation, the MRF and the prior
+  // cost as much per pixel there. The shared sets' masks cover a fifth of their views and their
+  // boxes under a third. Inside the mask the maps are those of the whole image up to the MRF's
+  // paths, which start at the crop's edge.
+  bool crop_to_mask = true;
   // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
   // and visual-hull bound from the first estimate to the geometric pass, which would compute
   // them again (width x height x 36 bytes a view: 22 MiB at 960 x 640); views beyond it are
@@ -427,6 +434,8 @@ struct OrientationStereoOptions {
       "geometric pass: weight of the sources' depth maps as a prior (0: filter only)");
     v("geom_prior_max_error_px", &geom_prior_max_error_px,
       "geometric pass: reprojection error (px) at which the prior costs the most");
+    v("crop_to_mask", &crop_to_mask,
+      "estimate on the mask's bounding box (with a margin) rather than the whole image");
     v("coarse_volume_cache_mib", &coarse_volume_cache_mib,
       "MiB for keeping the coarse volumes from the first estimate to the geometric pass");
     v("geom_consistency_iterations", &geom_consistency_iterations,

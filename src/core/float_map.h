@@ -3,6 +3,7 @@
 // Stored planar (channel-major) exactly as COLMAP's dense Mat files: element (row, col,
 // channel) is data[channel * width * height + row * width + col].
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -40,5 +41,29 @@ class FloatMap {
   int channels_ = 0;
   std::vector<float> data_;
 };
+
+// The width x height part of `map` whose top-left pixel is (x0, y0), all channels; it must lie
+// inside `map`.
+inline FloatMap CropFloatMap(const FloatMap& map, int x0, int y0, int width, int height) {
+  FloatMap part(width, height, map.Channels());
+  for (int c = 0; c < map.Channels(); ++c) {
+    for (int row = 0; row < height; ++row) {
+      const float* from = map.Channel(c) + static_cast<size_t>(y0 + row) * map.Width() + x0;
+      std::copy(from, from + width, part.Channel(c) + static_cast<size_t>(row) * width);
+    }
+  }
+  return part;
+}
+
+// `part` written into `whole` (same channels) with its top-left pixel at (x0, y0).
+inline void PasteFloatMap(const FloatMap& part, int x0, int y0, FloatMap* whole) {
+  for (int c = 0; c < part.Channels(); ++c) {
+    for (int row = 0; row < part.Height(); ++row) {
+      const float* from = part.Channel(c) + static_cast<size_t>(row) * part.Width();
+      std::copy(from, from + part.Width(),
+                whole->Channel(c) + static_cast<size_t>(y0 + row) * whole->Width() + x0);
+    }
+  }
+}
 
 }  // namespace hairmvs

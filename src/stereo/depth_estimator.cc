@@ -258,13 +258,17 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
   return out;
 }
 
-DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
-                               const std::vector<const StereoViewData*>& sources,
-                               const FloatMap& mask, const FloatMap& visual_hull_entry,
-                               const DepthLabels& labels,
-                               const OrientationStereoOptions& options, StageTimings* timings,
-                               Progress* progress, const GeometricPrior* prior,
-                               std::vector<float>* coarse_volume_cache) {
+namespace {
+
+// EstimateDepthMap on the reference's whole grid.
+DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewData& ref,
+                                     const std::vector<const StereoViewData*>& sources,
+                                     const FloatMap& mask, const FloatMap& visual_hull_entry,
+                                     const DepthLabels& labels,
+                                     const OrientationStereoOptions& options,
+                                     StageTimings* timings, Progress* progress,
+                                     const GeometricPrior* prior,
+                                     std::vector<float>* coarse_volume_cache) {
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
   THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
   const bool colour = options.MatchesColour();
@@ -648,6 +652,124 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
     if (valid) ++estimate.num_valid;
   }
   estimate.depth = std::move(depth);
+  return estimate;
+}
+
+// The part of the reference's level-0 grid that the estimate needs: the mask's bounding box
+// grown by `margin` px, its top-left corner and its size (unless it ends at the grid's edge)
+// multiples of `align` = 2^(last pyramid level), so that every level's grid is the matching
+// part of the whole level's (PyramidLevel: ceil(size / 2) per level). Empty (width 0) when
+// the mask has no pixel.
+struct GridCrop {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+};
+
+GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
+  int min_col = mask.Width(), max_col = -1, min_row = mask.Height(), max_row = -1;
+  for (int row = 0; row < mask.Height(); ++row) {
+    for (int col = 0; col < mask.Width(); ++col) {
+      if (mask.At(row, col) <= 0.5f) continue;
+      min_col = std::min(min_col, col);
+      max_col = std::max(max_col, col);
+      min_row = std::min(min_row, row);
+      max_row = std::max(max_row, row);
+    }
+  }
+  GridCrop crop;
+  if (max_col < 0) return crop;
+  auto down = [&](int v) { return std::max(0, (v - margin) / align * align); };
+  auto up = [&](int v, int size) {
+    return std::min(size, (v + 1 + margin + align - 1) / align * align);
+  };
+  crop.x0 = down(min_col);
+  crop.y0 = down(min_row);
+  crop.width = up(max_col, mask.Width()) - crop.x0;
+  crop.height = up(max_row, mask.Height()) - crop.y0;
+  return crop;
+}
+
+// Level `level` of a pyramid (orientation fields or colours) cropped as `crop` is at level 0.
+FloatMap CropLevel(const FloatMap& map, const GridCrop& crop, int level) {
+  int width = crop.width, height = crop.height;
+  for (int l = 0; l < level; ++l) {
+    width = (width + 1) / 2;
+    height = (height + 1) / 2;
+  }
+  const int x0 = crop.x0 >> level, y0 = crop.y0 >> level;
+  CHECK_LE(x0 + width, map.Width());
+  CHECK_LE(y0 + height, map.Height());
+  return CropFloatMap(map, x0, y0, width, height);
+}
+
+}  // namespace
+
+DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref,
+                               const std::vector<const StereoViewData*>& sources,
+                               const FloatMap& mask, const FloatMap& visual_hull_entry,
+                               const DepthLabels& labels,
+                               const OrientationStereoOptions& options, StageTimings* timings,
+                               Progress* progress, const GeometricPrior* prior,
+                               std::vector<float>* coarse_volume_cache) {
+  auto whole_grid = [&] {
+    return EstimateDepthMapOnGrid(context, ref, sources, mask, visual_hull_entry, labels, options,
+                                  timings, progress, prior, coarse_volume_cache);
+  };
+  if (!options.crop_to_mask || mask.Empty() || ref.orientation.empty()) return whole_grid();
+  const int width0 = ref.orientation[0].Width(), height0 = ref.orientation[0].Height();
+  CHECK_EQ(mask.Width(), width0);
+  CHECK_EQ(mask.Height(), height0);
+  const size_t num_levels =
+      std::max({ref.orientation.size(), ref.matching.size(), ref.rgb.size()});
+  // Past the farthest any window reaches from a masked pixel: the aggregation's at every level
+  // (in level-0 px), the final filter's (level 0's) and the colour cost's NCC window; twice
+  // that, so that a window at the mask's edge sees the same zeros it saw on the whole grid.
+  int reach = options.ncc_window_px / 2 + 1;
+  for (size_t l = 0; l < num_levels; ++l) {
+    reach = std::max(reach, (options.WindowPx(static_cast<int>(l)) / 2 + 1) << l);
+  }
+  const GridCrop crop = MaskCrop(mask, 2 * reach, 1 << (num_levels - 1));
+  if (crop.width == 0 || (crop.width == width0 && crop.height == height0)) return whole_grid();
+
+  StereoViewData part;
+  part.camera = ref.camera;
+  part.camera.K(0, 2) -= crop.x0;
+  part.camera.K(1, 2) -= crop.y0;
+  part.camera.width = crop.width;
+  part.camera.height = crop.height;
+  for (size_t l = 0; l < ref.orientation.size(); ++l) {
+    part.orientation.push_back(CropLevel(ref.orientation[l], crop, static_cast<int>(l)));
+  }
+  for (size_t l = 0; l < ref.matching.size(); ++l) {
+    part.matching.push_back(CropLevel(ref.matching[l], crop, static_cast<int>(l)));
+  }
+  for (size_t l = 0; l < ref.rgb.size(); ++l) {
+    part.rgb.push_back(CropLevel(ref.rgb[l], crop, static_cast<int>(l)));
+  }
+  const FloatMap part_mask = CropLevel(mask, crop, 0);
+  const FloatMap part_hull =
+      visual_hull_entry.Empty() ? FloatMap() : CropLevel(visual_hull_entry, crop, 0);
+  DepthEstimate estimate =
+      EstimateDepthMapOnGrid(context, part, sources, part_mask, part_hull, labels, options,
+                             timings, progress, prior, coarse_volume_cache);
+  // Back onto the whole grid: nothing outside the crop (the mask's zeros, as on the whole grid).
+  FloatMap depth(width0, height0, 1), confidence(width0, height0, 1);
+  PasteFloatMap(estimate.depth, crop.x0, crop.y0, &depth);
+  PasteFloatMap(estimate.confidence, crop.x0, crop.y0, &confidence);
+  estimate.depth = std::move(depth);
+  estimate.confidence = std::move(confidence);
+  FloatMap& data_term = estimate.coarse_data_term.cost;
+  if (!data_term.Empty()) {
+    int level = 0;
+    StereoCamera whole = ref.camera;
+    for (StereoCamera grid = part.camera; grid.width != data_term.Width(); ++level) {
+      CHECK_LT(level, 16);
+      grid = grid.PyramidLevel(1);
+      whole = whole.PyramidLevel(1);
+    }
+    FloatMap whole_term(whole.width, whole.height, data_term.Channels());
+    PasteFloatMap(data_term, crop.x0 >> level, crop.y0 >> level, &whole_term);
+    data_term = std::move(whole_term);
+  }
   return estimate;
 }
 

@@ -52,6 +52,7 @@ struct Result {
   double completeness = 0;
   double fine_energy = 0;  // the fine stage's MRF energy
   FloatMap coarse_data_term;  // with options.write_cost_volume
+  FloatMap depth;
 };
 
 // The rendered grey picture as the 3-channel colour image the photometric cost matches.
@@ -66,10 +67,10 @@ FloatMap GreyToRgb(const FloatMap& gray) {
 // Renders the views, estimates the reference's depth map, compares with the truth on pixels
 // where the truth exists.
 // hull_margin_m > 0: a visual hull whose entry lies that far in front of the true depth at
-// every pixel with one (none elsewhere).
+// every pixel with one (none elsewhere). `mask`: the reference's (empty: none).
 Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& cameras,
                    double depth_min, double depth_max, OrientationStereoOptions options,
-                   unsigned seed, double hull_margin_m = 0) {
+                   unsigned seed, double hull_margin_m = 0, const FloatMap& mask = FloatMap()) {
   const auto strands = MakeStrands(surface, 900, surface.sphere ? 0.9 : 0.6, 0.25, seed);
   std::vector<StereoViewData> views;
   FloatMap true_depth;
@@ -90,7 +91,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
       if (d > 0) hull_entry.Data()[p] = d - static_cast<float>(hull_margin_m);
     }
   }
-  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
+  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, mask,
                                                   hull_entry, labels, options, nullptr);
   const size_t truth = std::count_if(true_depth.Data().begin(), true_depth.Data().end(),
                                      [](float d) { return d > 0; });
@@ -100,6 +101,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
   result.completeness = truth > 0 ? static_cast<double>(estimated) / truth : 0;
   result.fine_energy = estimate.fine_energy;
   result.coarse_data_term = estimate.coarse_data_term.cost;
+  result.depth = estimate.depth;
   return result;
 }
 
@@ -142,6 +144,73 @@ TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
               result.completeness);
   EXPECT_LT(result.median_abs_error_m, 0.01);
   EXPECT_GT(result.completeness, 0.8);
+}
+
+// crop_to_mask: the estimate on the mask's box (with its margin) has the whole image's data
+// term inside the mask, the same depths up to the MRF's paths, and nothing outside the mask.
+TEST(DepthEstimator, CropToTheMaskKeepsTheWholeImagesDataTermAndDepths) {
+  OrientationStereoOptions options = TestOptions();
+  // Small windows, so that the box and its margin (twice the farthest reach, 8 level-0 px at
+  // level 2) fit inside these 96 x 72 views: a crop of 48 x 48 px.
+  options.window_px_level0 = 3;
+  options.window_px_level1 = 3;
+  options.window_px_level2 = 3;
+  options.write_cost_volume = true;
+  FloatMap mask(96, 72, 1);
+  for (int row = 28; row < 44; ++row) {
+    for (int col = 40; col < 56; ++col) mask.At(row, col) = 1.0f;
+  }
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const Result cropped = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1, 0, mask);
+  options.crop_to_mask = false;
+  const Result whole = Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1, 0, mask);
+  ASSERT_EQ(cropped.depth.Width(), 96);
+  ASSERT_EQ(cropped.depth.Height(), 72);
+  ASSERT_EQ(cropped.coarse_data_term.Width(), whole.coarse_data_term.Width());
+  ASSERT_EQ(cropped.coarse_data_term.Channels(), options.num_depths);
+  // The data term on the coarse (level 1) pixels inside the mask.
+  double largest_cost = 0, largest_difference = 0;
+  for (int row = 14; row < 22; ++row) {
+    for (int col = 20; col < 28; ++col) {
+      for (int k = 0; k < options.num_depths; ++k) {
+        const float c = whole.coarse_data_term.At(row, col, k);
+        largest_cost = std::max(largest_cost, std::abs(static_cast<double>(c)));
+        const double difference = cropped.coarse_data_term.At(row, col, k) - c;
+        largest_difference = std::max(largest_difference, std::abs(difference));
+      }
+    }
+  }
+  EXPECT_GT(largest_cost, 0.0);
+  EXPECT_LE(largest_difference, 1e-5 * largest_cost);
+  // It did crop: these fields are not masked, so the whole image has a data term at the
+  // corner, the crop none.
+  double corner_whole = 0, corner_cropped = 0;
+  for (int k = 0; k < options.num_depths; ++k) {
+    corner_whole += std::abs(whole.coarse_data_term.At(2, 2, k));
+    corner_cropped += std::abs(cropped.coarse_data_term.At(2, 2, k));
+  }
+  EXPECT_GT(corner_whole, 0.0);
+  EXPECT_EQ(corner_cropped, 0.0);
+  int inside = 0, close = 0;
+  for (int row = 0; row < 72; ++row) {
+    for (int col = 0; col < 96; ++col) {
+      const float c = cropped.depth.At(row, col), w = whole.depth.At(row, col);
+      if (mask.At(row, col) == 0) {
+        EXPECT_EQ(c, 0.0f) << row << " " << col;
+        EXPECT_EQ(w, 0.0f) << row << " " << col;
+        continue;
+      }
+      ++inside;
+      close += c > 0 && w > 0 && std::abs(c - w) < 0.002f;
+    }
+  }
+  std::printf("crop to the mask: %d of %d masked depths within 2 mm of the whole image's; median "
+              "|error| %.4f m (whole image %.4f m)\n",
+              close, inside, cropped.median_abs_error_m, whole.median_abs_error_m);
+  EXPECT_GT(close, inside * 9 / 10);
+  EXPECT_LT(cropped.median_abs_error_m, 0.01);
 }
 
 // The coarse stage without level 0 (coarse_first_level 1, a speed option) still finds the

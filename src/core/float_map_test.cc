@@ -1,0 +1,45 @@
+#include "src/core/float_map.h"
+
+#include <gtest/gtest.h>
+
+namespace hairmvs {
+namespace {
+
+// A 2-channel map whose value names its row, column and channel.
+FloatMap NumberedMap(int width, int height) {
+  FloatMap map(width, height, 2);
+  for (int c = 0; c < 2; ++c) {
+    for (int row = 0; row < height; ++row) {
+      for (int col = 0; col < width; ++col) map.At(row, col, c) = 1000 * c + 100 * row + col;
+    }
+  }
+  return map;
+}
+
+TEST(FloatMap, CropAndPasteKeepEveryChannelInPlace) {
+  const FloatMap map = NumberedMap(7, 5);
+  const FloatMap part = CropFloatMap(map, 2, 1, 4, 3);
+  ASSERT_EQ(part.Width(), 4);
+  ASSERT_EQ(part.Height(), 3);
+  ASSERT_EQ(part.Channels(), 2);
+  for (int c = 0; c < 2; ++c) {
+    for (int row = 0; row < 3; ++row) {
+      for (int col = 0; col < 4; ++col) {
+        EXPECT_EQ(part.At(row, col, c), map.At(row + 1, col + 2, c));
+      }
+    }
+  }
+  FloatMap whole(7, 5, 2, -1.0f);
+  PasteFloatMap(part, 2, 1, &whole);
+  for (int c = 0; c < 2; ++c) {
+    for (int row = 0; row < 5; ++row) {
+      for (int col = 0; col < 7; ++col) {
+        const bool inside = row >= 1 && row < 4 && col >= 2 && col < 6;
+        EXPECT_EQ(whole.At(row, col, c), inside ? map.At(row, col, c) : -1.0f) << row << col;
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace hairmvs
