@@ -656,13 +656,32 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
 }
 
 // The part of the reference's level-0 grid that the estimate needs: the mask's bounding box
-// grown by `margin` px, its top-left corner and its size (unless it ends at the grid's edge)
-// multiples of `align` = 2^(last pyramid level), so that every level's grid is the matching
-// part of the whole level's (PyramidLevel: ceil(size / 2) per level). Empty (width 0) when
-// the mask has no pixel.
+// grown by `margin` px, its top-left corner a multiple of `align` = 2^(last pyramid level), so
+// that every level's grid is the matching part of the whole level's (PyramidLevel: ceil(size /
+// 2) per level), and its width and height multiples of kCropSizeMultiple where the image allows
+// (moved back from the image's edge if need be): PoCL runs a kernel in work-groups whose size
+// divides the global size, and sizes with few factors of 2 leave it small groups, which it
+// vectorises less well. Empty (width 0) when the mask has no pixel.
 struct GridCrop {
   int x0 = 0, y0 = 0, width = 0, height = 0;
 };
+
+constexpr int kCropSizeMultiple = 32;
+
+// [start, start + size) along an axis of `length` px holding [first, last] grown by margin.
+void CropAxis(int first, int last, int length, int margin, int align, int* start, int* size) {
+  const int begin = std::max(0, (first - margin) / align * align);
+  const int end = std::min(length, last + 1 + margin);
+  const int rounded =
+      (end - begin + kCropSizeMultiple - 1) / kCropSizeMultiple * kCropSizeMultiple;
+  *start = begin;
+  *size = rounded;
+  if (begin + rounded > length) {  // moved back from the edge, keeping the alignment
+    *start = std::max(0, (length - rounded) / align * align);
+    // Up to the edge where the alignment or the image leaves less than the box.
+    if (*start + rounded < end || rounded > length) *size = length - *start;
+  }
+}
 
 GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
   int min_col = mask.Width(), max_col = -1, min_row = mask.Height(), max_row = -1;
@@ -677,14 +696,8 @@ GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
   }
   GridCrop crop;
   if (max_col < 0) return crop;
-  auto down = [&](int v) { return std::max(0, (v - margin) / align * align); };
-  auto up = [&](int v, int size) {
-    return std::min(size, (v + 1 + margin + align - 1) / align * align);
-  };
-  crop.x0 = down(min_col);
-  crop.y0 = down(min_row);
-  crop.width = up(max_col, mask.Width()) - crop.x0;
-  crop.height = up(max_row, mask.Height()) - crop.y0;
+  CropAxis(min_col, max_col, mask.Width(), margin, align, &crop.x0, &crop.width);
+  CropAxis(min_row, max_row, mask.Height(), margin, align, &crop.y0, &crop.height);
   return crop;
 }
 
