@@ -735,7 +735,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
       std::max({ref.orientation.size(), ref.matching.size(), ref.rgb.size()});
   // Past the farthest any window reaches from a masked pixel: the aggregation's at every level
   // (in level-0 px), the final filter's (level 0's) and the colour cost's NCC window; twice
-  // that, so that a window at the mask's edge sees the same zeros it saw on the whole grid.
+  // that, so that a window near the mask's edge sees what it saw on the whole grid.
   int reach = options.ncc_window_px / 2 + 1;
   for (size_t l = 0; l < num_levels; ++l) {
     reach = std::max(reach, (options.WindowPx(static_cast<int>(l)) / 2 + 1) << l);
