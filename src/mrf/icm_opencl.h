@@ -16,7 +16,7 @@ constexpr int kMrfLocalSize = 16;
 
 // `count` work items rounded up to a multiple of kMrfLocalSize.
 inline cl::NDRange MrfGlobalRange(size_t count) {
-  return cl::NDRange((count + kMrfLocalSize - 1) / kMrfLocalSize * kMrfLocalSize);
+  return cl::NDRange(RoundUpToMultiple(count, kMrfLocalSize));
 }
 
 // Blocks until the queue is done and returns the n labels of `labels`.

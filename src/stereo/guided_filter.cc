@@ -13,6 +13,20 @@ cl::Program& GuidedFilterProgram(OpenCLContext* context) {
   return context->Program({"guided_filter.cl"});
 }
 
+// Work-group sizes: per pixel (the guided filter's pointwise kernels) and per row or group of
+// columns (the box filter's passes). Fixed, so that PoCL vectorises whatever the image's size
+// (RoundUpToMultiple); the kernels check their bounds.
+constexpr size_t kPixelGroup = 64;
+constexpr size_t kLineGroup = 16;
+
+// `count` work-items (rounded up) by `planes`, in groups of `group` x 1.
+void EnqueueLines(cl::CommandQueue& queue, const cl::Kernel& kernel, size_t count,
+                  size_t planes, size_t group) {
+  queue.enqueueNDRangeKernel(kernel, cl::NullRange,
+                             cl::NDRange(RoundUpToMultiple(count, group), planes),
+                             cl::NDRange(group, 1));
+}
+
 }  // namespace
 
 BoxFilterCL::BoxFilterCL(OpenCLContext* context)
@@ -27,15 +41,14 @@ void BoxFilterCL::Mean(const cl::Buffer& in, const cl::Buffer& scratch, const cl
   rows_.setArg(2, width);
   rows_.setArg(3, height);
   rows_.setArg(4, radius);
-  context_->Queue().enqueueNDRangeKernel(rows_, cl::NullRange, cl::NDRange(height, num_planes));
+  EnqueueLines(context_->Queue(), rows_, height, num_planes, kLineGroup);
   cols_.setArg(0, scratch);
   cols_.setArg(1, out);
   cols_.setArg(2, width);
   cols_.setArg(3, height);
   cols_.setArg(4, radius);
   // box_cols: a work-item per 8 columns.
-  context_->Queue().enqueueNDRangeKernel(cols_, cl::NullRange,
-                                         cl::NDRange((width + 7) / 8, num_planes));
+  EnqueueLines(context_->Queue(), cols_, (width + 7) / 8, num_planes, kLineGroup);
 }
 
 GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, int radius,
@@ -58,13 +71,13 @@ GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, in
   guide_planes.setArg(0, guide_);
   guide_planes.setArg(1, planes);
   guide_planes.setArg(2, n);
-  context->Queue().enqueueNDRangeKernel(guide_planes, cl::NullRange, cl::NDRange(n));
+  EnqueueLines(context->Queue(), guide_planes, n, 1, kPixelGroup);
   box_.Mean(planes, scratch, stats_, width_, height_, 3, radius_);
   cl::Kernel guide_stats(GuidedFilterProgram(context), "gf_guide_stats");
   guide_stats.setArg(0, stats_);
   guide_stats.setArg(1, n);
   guide_stats.setArg(2, eps);
-  context->Queue().enqueueNDRangeKernel(guide_stats, cl::NullRange, cl::NDRange(n));
+  EnqueueLines(context->Queue(), guide_stats, n, 1, kPixelGroup);
 }
 
 void GuidedFilterCL::EnsureScratch(int num_slices) {
@@ -83,18 +96,18 @@ void GuidedFilterCL::Filter(const cl::Buffer& in, int num_slices, const cl::Buff
   products_.setArg(1, guide_);
   products_.setArg(2, planes_);
   products_.setArg(3, n);
-  queue.enqueueNDRangeKernel(products_, cl::NullRange, cl::NDRange(n, num_slices));
+  EnqueueLines(queue, products_, n, num_slices, kPixelGroup);
   box_.Mean(planes_, scratch_, planes_, width_, height_, 3 * num_slices, radius_);
   coefficients_.setArg(0, planes_);
   coefficients_.setArg(1, stats_);
   coefficients_.setArg(2, n);
-  queue.enqueueNDRangeKernel(coefficients_, cl::NullRange, cl::NDRange(n, num_slices));
+  EnqueueLines(queue, coefficients_, n, num_slices, kPixelGroup);
   box_.Mean(planes_, scratch_, planes_, width_, height_, 3 * num_slices, radius_);
   output_.setArg(0, planes_);
   output_.setArg(1, guide_);
   output_.setArg(2, out);
   output_.setArg(3, n);
-  queue.enqueueNDRangeKernel(output_, cl::NullRange, cl::NDRange(n, num_slices));
+  EnqueueLines(queue, output_, n, num_slices, kPixelGroup);
 }
 
 FloatMap GuidedFilterCL::Filter(const FloatMap& input) {
