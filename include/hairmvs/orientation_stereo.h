@@ -348,7 +348,7 @@ struct OrientationStereoOptions {
   // either way): synth_straight_gantry 159 / 113 s (the MRF 47 / 23 s, the aggregation 41 / 20
   // s), peak 1.9 / 1.4 GB, per-pixel median 4.31 / 4.32 mm; synth_handheld 111 / 75-82 s, 1.2 /
   // 0.9 GB, 5.37 / 5.41 mm; a 1404 x 936 T group 21.9 s in the stage table (4 views; 45 s before
-  // both savings).
+  // both savings; 19.2 s with the filters' fixed work-groups).
   bool crop_to_mask = true;
   // Memory (MiB) for keeping each view's coarse volume (all labels, aggregated), depth range
   // and visual-hull bound from the first estimate to the geometric pass, which would compute
