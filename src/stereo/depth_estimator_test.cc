@@ -151,7 +151,8 @@ TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
 TEST(DepthEstimator, CropToTheMaskKeepsTheWholeImagesDataTermAndDepths) {
   OrientationStereoOptions options = TestOptions();
   // Small windows, so that the box and its margin (twice the farthest reach, 8 level-0 px at
-  // level 2) fit inside these 96 x 72 views: a crop of 48 x 48 px.
+  // level 2) fit inside these 96 x 72 views: a crop of 64 x 64 px (48 x 48 rounded up to
+  // multiples of 32, moved back from the bottom edge).
   options.window_px_level0 = 3;
   options.window_px_level1 = 3;
   options.window_px_level2 = 3;
