@@ -145,13 +145,8 @@ OrientationFieldComputer::OrientationFieldComputer(std::shared_ptr<OpenCLContext
   build_options << "-D VEC=" << config_.vector_width << " -D BLOCK=" << config_.block_size;
   cl::Program& program = context_->Program({"orientation.cl"}, build_options.str());
   state_->kernel = cl::Kernel(program, "orientation_field");
-  cl::Context& ctx = context_->Context();
-  state_->tap_begin = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                 blocked_.tap_begin.size() * sizeof(int),
-                                 const_cast<int*>(blocked_.tap_begin.data()));
-  state_->weights = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                               blocked_.weights.size() * sizeof(float),
-                               const_cast<float*>(blocked_.weights.data()));
+  state_->tap_begin = ReadOnlyBuffer(context_.get(), blocked_.tap_begin);
+  state_->weights = ReadOnlyBuffer(context_.get(), blocked_.weights);
 }
 
 OrientationFieldComputer::~OrientationFieldComputer() = default;
@@ -226,9 +221,7 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
       for (size_t t = 0; t < blocked_.tap_dx.size(); ++t) {
         s.tap_offsets_host[t] = blocked_.tap_dy[t] * padded_stride + blocked_.tap_dx[t];
       }
-      s.tap_offsets = cl::Buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                 s.tap_offsets_host.size() * sizeof(int),
-                                 s.tap_offsets_host.data());
+      s.tap_offsets = ReadOnlyBuffer(context_.get(), s.tap_offsets_host);
       s.tap_offsets_stride = padded_stride;
     }
     queue.enqueueWriteBuffer(s.padded, CL_FALSE, 0, padded_bytes, s.padded_host.data());

@@ -376,8 +376,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
         blocks.emplace_back();
         continue;
       }
-      base_buffers.emplace_back(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                                sizeof(float) * n, const_cast<float*>(base[l].data()));
+      base_buffers.push_back(ReadOnlyBuffer(context, base[l]));
       blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
     }
     // Selecting sources: each cost's own volume (one after another in `source_volumes`), its

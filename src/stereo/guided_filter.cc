@@ -62,8 +62,7 @@ GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, in
   CHECK_GE(radius, 0);
   const int n = width_ * height_;
   const size_t plane_bytes = sizeof(float) * n;
-  guide_ = cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                      2 * plane_bytes, const_cast<float*>(guide.Data().data()));
+  guide_ = ReadOnlyBuffer(context, guide.Data());
   cl::Buffer planes(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
   cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
   stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
