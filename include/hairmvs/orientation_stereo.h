@@ -12,6 +12,7 @@
 // stereo/confidence_maps/<name>.bin (of the map written last), and optionally coloured PNG
 // pictures of depths and normals.
 
+#include <algorithm>
 #include <string>
 #include <utility>
 #include <vector>
@@ -100,14 +101,16 @@ struct OrientationStereoOptions {
   // g0_c, g2_c, g4_c, g5_r per-pixel median 6.12 -> 5.87 mm; a synthesised curly T group
   // (100k strands, 960 px) 3.41 -> 2.94 mm.
   int num_depths = 128;
-  // Orientation pyramid levels used by the data term (paper: 3). The coarser levels see the
-  // front strands most: with 1 (then one stage at full resolution) the synth_straight_gantry
-  // g2 group's .geometric maps sit less far in front inside the hair (signed -2.42 -> -1.93 mm)
-  // but err more near the silhouettes (5.73 -> 6.29 mm): median 4.04 -> 3.99 mm, 3D median
-  // 0.522 -> 0.484 mm, in 2.5x the time and twice the memory (12 -> 30 s, 0.70 -> 1.47 GB);
-  // with 2, 4.06 mm. The same data term with level 0 alone kept coarse to fine (a prototype, not
-  // kept): all 32 gantry views 4.32 -> 4.20 mm, the curly demo 2.37 -> 2.28 mm, but
-  // synth_handheld, whose level-0 orientation cost is weakest, 5.41 -> 6.82 mm.
+  // Orientation pyramid levels used by the data term (paper: 3), finest first. The pyramid
+  // itself reaches coarse_level too (PyramidLevels), whose grid the coarse stage solves on
+  // whatever the data term sums (the data term keeps its scale against lambda). The coarser
+  // levels see the front strands most. Measured with 1 against 3 (.geometric maps; complete /
+  // per-pixel mean / median / 3D mean / 3D median, mm): synth_straight_gantry 98.7% / 7.87 /
+  // 4.21 / 1.028 / 0.551 against 98.6% / 8.08 / 4.32 / 1.190 / 0.557 (inside the hair signed
+  // -2.21 against -2.35 mm), 97 s; the curly demo 98.0% / 3.44 / 2.28 / 0.326 / 0.259 against
+  // 98.3% / 3.46 / 2.37 / 0.302 / 0.243; but synth_handheld, whose level-0 orientation cost is
+  // weakest, 93.6% / 12.57 / 6.82 / 1.661 / 0.697 against 92.2% / 10.86 / 5.41 / 1.774 / 0.632
+  // (first estimates 13.2 mm). With 2: the g2 group 4.09 against 4.04 mm.
   int num_levels = 3;
   // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
   // level 0 (finest), 1, 2. 15/11/7 measured better than 7/11/15 on synth_straight_gantry g0_c
@@ -479,6 +482,8 @@ struct OrientationStereoOptions {
   bool Check(std::string* error) const;
   // Window in px of a level (levels beyond 2 reuse the level-2 window).
   int WindowPx(int level) const;
+  // Orientation pyramid levels to compute: the data term's and the coarse stage's grid.
+  int PyramidLevels() const { return std::max(num_levels, coarse_level + 1); }
   // Whether the data term matches orientation fields (orientation or combined cost).
   bool MatchesOrientation() const { return cost != StereoCost::kPhotometric; }
   // Whether the data term matches colours (photometric or combined cost).
@@ -508,7 +513,7 @@ struct OrientationStereoResult {
 // `source_views` chooses the source views (null: SourceViewOptions' defaults, 4 views); an
 // explicit patch-match.cfg list is capped to its max_num_source_views. `field_options` (null:
 // the defaults, the paper's filter) computes the orientation fields that are not cached in
-// stereo/orientation_maps/ (its num_levels is replaced by options.num_levels).
+// stereo/orientation_maps/ (its num_levels is replaced by options.PyramidLevels()).
 // Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const std::vector<std::string>& image_names,

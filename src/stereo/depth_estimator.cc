@@ -75,6 +75,10 @@ FloatMap ScaleToRms(const FloatMap& field, double rms) {
 
 namespace {
 
+// The data term is scaled as the sum of this many levels (the paper's, num_levels' default),
+// whatever the levels used, so that lambda means the same with any num_levels.
+constexpr int kDataTermLevelsScale = 3;
+
 // Per-level machinery of one reference view.
 struct LevelPipeline {
   // The data term's costs (one, or orientation then colour when combined), each with its
@@ -272,13 +276,21 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   THROW_IF(ref.orientation.empty(), "EstimateDepthMap: the reference has no orientation field");
   THROW_IF(sources.empty(), "EstimateDepthMap: no source views");
   const bool colour = options.MatchesColour();
-  int num_levels = std::min<int>(options.num_levels, static_cast<int>(ref.orientation.size()));
+  // The pyramid levels every view has: the data term's (the first num_levels) and the coarse
+  // stage's grid.
+  int num_pyramid_levels = static_cast<int>(ref.orientation.size());
   for (const StereoViewData* src : sources) {
-    num_levels = std::min<int>(num_levels, static_cast<int>(src->orientation.size()));
-    if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(src->rgb.size()));
+    num_pyramid_levels =
+        std::min<int>(num_pyramid_levels, static_cast<int>(src->orientation.size()));
+    if (colour) {
+      num_pyramid_levels = std::min<int>(num_pyramid_levels, static_cast<int>(src->rgb.size()));
+    }
   }
-  if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(ref.rgb.size()));
-  THROW_IF(num_levels < 1, "EstimateDepthMap: no common pyramid level");
+  if (colour) {
+    num_pyramid_levels = std::min<int>(num_pyramid_levels, static_cast<int>(ref.rgb.size()));
+  }
+  THROW_IF(num_pyramid_levels < 1, "EstimateDepthMap: no common pyramid level");
+  const int num_levels = std::min(options.num_levels, num_pyramid_levels);
   const int width0 = ref.orientation[0].Width();
   const int height0 = ref.orientation[0].Height();
   cl::CommandQueue& queue = context->Queue();
@@ -286,7 +298,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
 
   // The guide of the aggregation and of the smoothness weights (see guide_rms).
   std::vector<FloatMap> scaled_guides;
-  for (int l = 0; l < num_levels && options.guide_rms > 0; ++l) {
+  for (int l = 0; l < num_pyramid_levels && options.guide_rms > 0; ++l) {
     scaled_guides.push_back(ScaleToRms(ref.orientation[l], options.guide_rms));
   }
   auto guide = [&](int l) -> const FloatMap& {
@@ -298,7 +310,11 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   }
   const bool strand_plane_from_hull =
       options.StrandPlaneFromVisualHull() && !visual_hull_entry.Empty();
-  std::vector<LevelPipeline> levels(num_levels);
+  std::vector<LevelPipeline> levels(num_pyramid_levels);
+  for (int l = 0; l < num_pyramid_levels; ++l) {
+    levels[l].width = ref.orientation[l].Width();
+    levels[l].height = ref.orientation[l].Height();
+  }
   const int num_sources = static_cast<int>(sources.size());
   const int num_best_sources = options.NumBestSources(num_sources);
   const bool select_sources = num_best_sources < num_sources;
@@ -338,8 +354,6 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
                weight, term});
         }
       }
-      levels[l].width = ref.orientation[l].Width();
-      levels[l].height = ref.orientation[l].Height();
     }
   }
   {
@@ -364,9 +378,11 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     cl::Buffer volume(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * host.size());
     queue.enqueueFillBuffer(volume, 0.0f, 0, sizeof(float) * host.size());
     const int block = std::max(1, std::min(options.slice_block, num_labels));
-    // Without the finest levels, the others count for them, so that the data term keeps its
-    // scale against lambda.
-    const float level_weight = static_cast<float>(num_levels) / (num_levels - first_level);
+    // The levels used count for the paper's three (kDataTermLevelsScale), so that the data term
+    // keeps its scale against lambda without the finest levels (coarse_first_level) or with
+    // fewer levels (num_levels).
+    const float level_weight =
+        static_cast<float>(kDataTermLevelsScale) / (num_levels - first_level);
     std::vector<cl::Buffer> base_buffers, blocks;
     for (int l = 0; l < num_levels; ++l) {
       const size_t n = static_cast<size_t>(levels[l].width) * levels[l].height;
@@ -452,9 +468,12 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
 
   DepthEstimate estimate;
   const int num_depths = labels.num_labels;
-  const bool two_stage = options.coarse_level > 0 && num_levels > 1;
-  const int coarse_level = two_stage ? std::min(options.coarse_level, num_levels - 1) : 0;
-  const int coarse_first_level = two_stage ? options.coarse_first_level : 0;
+  const bool two_stage = options.coarse_level > 0 && num_pyramid_levels > 1;
+  const int coarse_level = two_stage ? std::min(options.coarse_level, num_pyramid_levels - 1) : 0;
+  // The finest level of the coarse stage's data term: at most the grid's, and one of the
+  // data term's levels.
+  const int coarse_first_level =
+      two_stage ? std::min({options.coarse_first_level, coarse_level, num_levels - 1}) : 0;
 
   // The visual hull's depth bound (its entry less the tolerance) as labels on the level-0 grid
   // (-inf = none): where the coarse labels start, and, per visual_hull_depth_bound, a bound.
@@ -477,8 +496,8 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
   const bool coarse_from_hull =
       options.coarse_labels_from_visual_hull && !visual_hull_entry.Empty();
-  std::vector<std::vector<float>> coarse_base(num_levels);
-  for (int l = 0; l < num_levels; ++l) {
+  std::vector<std::vector<float>> coarse_base(num_pyramid_levels);
+  for (int l = 0; l < num_pyramid_levels; ++l) {
     coarse_base[l] = coarse_from_hull
                          ? VisualHullLabelBase(bound0, width0, height0, labels, l,
                                                levels[l].width, levels[l].height)
@@ -494,8 +513,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     coarse_volume = std::move(*coarse_volume_cache);
     coarse_volume_cache->clear();
   } else {
-    coarse_volume = build_volume(coarse_level, std::min(coarse_first_level, coarse_level),
-                                 num_depths, coarse_base, 1.0f);
+    coarse_volume = build_volume(coarse_level, coarse_first_level, num_depths, coarse_base, 1.0f);
     if (coarse_volume_cache != nullptr) *coarse_volume_cache = coarse_volume;
   }
   const bool use_prior = prior != nullptr && !prior->views.empty() && prior->weight > 0;
@@ -733,10 +751,10 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const size_t num_levels =
       std::max({ref.orientation.size(), ref.matching.size(), ref.rgb.size()});
   // Past the farthest any window reaches from a masked pixel: the aggregation's at every level
-  // (in level-0 px), the final filter's (level 0's) and the colour cost's NCC window; twice
-  // that, so that a window near the mask's edge sees what it saw on the whole grid.
+  // of the data term (in level-0 px), the final filter's (level 0's) and the colour cost's NCC
+  // window; twice that, so that a window near the mask's edge sees what it saw on the whole grid.
   int reach = options.ncc_window_px / 2 + 1;
-  for (size_t l = 0; l < num_levels; ++l) {
+  for (size_t l = 0; l < std::min<size_t>(num_levels, options.num_levels); ++l) {
     reach = std::max(reach, (options.WindowPx(static_cast<int>(l)) / 2 + 1) << l);
   }
   const GridCrop crop = MaskCrop(mask, 2 * reach, 1 << (num_levels - 1));

@@ -229,6 +229,30 @@ TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
   EXPECT_NE(result.median_abs_error_m, all_levels.median_abs_error_m);  // level 0 was left out
 }
 
+// A data term of level 0 alone (num_levels 1) is still solved coarse to fine, on the grid of
+// coarse_level, which the pyramid reaches whatever num_levels: the coarse data term has the
+// grid's size, the fine stage runs, and the plane is found.
+TEST(DepthEstimator, OneLevelDataTermIsStillSolvedCoarseToFine) {
+  OrientationStereoOptions options = TestOptions();  // coarse_level 1: a 48 x 36 grid
+  options.num_levels = 1;
+  options.write_cost_volume = true;
+  EXPECT_EQ(options.PyramidLevels(), 2);
+  const Result result = ReconstructTiltedPlane(options);
+  std::printf("plane, level 0 alone: median |error| %.4f m, completeness %.3f\n",
+              result.median_abs_error_m, result.completeness);
+  EXPECT_EQ(result.coarse_data_term.Width(), 48);
+  EXPECT_EQ(result.coarse_data_term.Height(), 36);
+  EXPECT_NE(result.fine_energy, 0);  // the fine stage ran (costs are negative: so is it)
+  EXPECT_LT(result.median_abs_error_m, 0.01);
+  EXPECT_GT(result.completeness, 0.8);
+  // Single stage: the whole grid, no fine stage.
+  options.coarse_level = -1;
+  EXPECT_EQ(options.PyramidLevels(), 1);
+  const Result single = ReconstructTiltedPlane(options);
+  EXPECT_EQ(single.coarse_data_term.Width(), 96);
+  EXPECT_EQ(single.fine_energy, 0);
+}
+
 // --OrientationStereo.mrf_icm_polish_iterations reaches the solver: without the ICM polish
 // the semi-global labels keep a higher energy, and the plane is still recovered.
 TEST(DepthEstimator, IcmPolishLowersTheEnergyOfTheSemiGlobalLabels) {

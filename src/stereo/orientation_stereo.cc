@@ -341,12 +341,12 @@ class ViewLoader {
 
     // Expected level sizes.
     std::vector<std::array<int, 2>> sizes;
-    for (int l = 0; l < options_.num_levels; ++l) {
+    for (int l = 0; l < options_.PyramidLevels(); ++l) {
       const StereoCamera level = data.camera.PyramidLevel(l);
       sizes.push_back({level.width, level.height});
     }
     bool reused = options_.reuse_orientation_maps;
-    for (int l = 0; l < options_.num_levels && reused; ++l) {
+    for (int l = 0; l < options_.PyramidLevels() && reused; ++l) {
       const std::string path = workspace_.OrientationMapPath(name, l);
       if (!ExistsFile(path)) {
         reused = false;
@@ -367,7 +367,7 @@ class ViewLoader {
       const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
         OrientationFieldOptions field_options = field_options_;
-        field_options.num_levels = options_.num_levels;
+        field_options.num_levels = options_.PyramidLevels();
         computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
       }
       data.orientation = computer_->Compute(gray, mask);
@@ -386,7 +386,7 @@ class ViewLoader {
     }
     if (options_.MatchesColour()) {
       data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
-      for (int l = 1; l < options_.num_levels; ++l) {
+      for (int l = 1; l < options_.PyramidLevels(); ++l) {
         data.rgb.push_back(DownsampleHalf(data.rgb.back()));
       }
     }
