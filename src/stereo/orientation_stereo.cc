@@ -495,7 +495,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       std::string range_source = "options";
       if (depth_min <= 0 || depth_max <= 0) {
         const uint32_t image_id = workspace.ImageByName(name).image_id;
-        const DepthRange range = options.depth_range_from_mask
+        // Without a mask file the view's mask is all ones: every point counts, as COLMAP's rule.
+        const DepthRange range = options.depth_range_from_mask && !workspace.MaskPath(name).empty()
                                      ? ComputeDepthRange(workspace.Model(), image_id, mask)
                                      : ComputeDepthRange(workspace.Model(), image_id);
         if (depth_min <= 0) depth_min = range.min_m;
