@@ -1,11 +1,15 @@
 // Throughput of the stereo kernels on PoCL: the orientation and photometric cost volumes and
-// the guided filter for one block of depth slices at 960 x 640 (the gantry set's size), 3 source views.
+// the guided filter for one block of depth slices at 960 x 640 (the gantry set's size), 3 source
+// views; the geometric pass's prior for a fine band of 16 labels and 8 other views' maps.
 // Run: ./build-stereo/bench/stereo_benchmark
 
 #include <benchmark/benchmark.h>
 
+#include <cmath>
+
 #include "src/opencl/opencl_context.h"
 #include "src/stereo/cost_volume.h"
+#include "src/stereo/geometric_prior.h"
 #include "src/stereo/guided_filter.h"
 #include "src/stereo/stereo_test_util.h"
 
@@ -88,6 +92,41 @@ void BM_GuidedFilter(benchmark::State& state) {
       1e-6 * kWidth * kHeight * kSlices, benchmark::Counter::kIsIterationInvariantRate);
 }
 BENCHMARK(BM_GuidedFilter)->Arg(3)->Arg(7)->Unit(benchmark::kMillisecond);
+
+// The geometric pass's prior (kernels/geometric_prior.cl) on the fine band: 16 labels half a
+// label apart around a random base, every pixel, 8 other views 0.1 m apart whose maps hold a
+// noisy plane 0.6 m away (the gantry's geometric pass reads 3 to 23 maps per view).
+void BM_GeometricPrior(benchmark::State& state) {
+  auto context = OpenCLContext::Create();
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 0.6}, 768, kWidth, kHeight);
+  std::vector<FusionView> views;
+  for (int v = 0; v < 8; ++v) {
+    const double angle = 2 * 3.14159265358979 * v / 8;
+    const StereoCamera camera = LookAtCamera(
+        {0.1 * std::cos(angle), 0.1 * std::sin(angle), 0}, {0, 0, 0.6}, 768, kWidth, kHeight);
+    FusionView view;
+    view.K = camera.K;
+    view.R = camera.R;
+    view.t = camera.t;
+    view.depth = RandomMap(kWidth, kHeight, 1, 10 + v, 0.59f, 0.61f);
+    views.push_back(std::move(view));
+  }
+  GeometricPrior prior;
+  for (const FusionView& view : views) prior.views.push_back(&view);
+  prior.weight = 2;
+  prior.max_error_px = 6;
+  GeometricPriorCL prior_cl(context.get(), prior);
+  const DepthLabels labels(0.4, 0.8, 128, true);
+  const FloatMap base = RandomMap(kWidth, kHeight, 1, 9, 50, 60);
+  constexpr int kBand = 16;
+  std::vector<float> volume(static_cast<size_t>(kWidth) * kHeight * kBand, 0.0f);
+  for (auto _ : state) {
+    prior_cl.Add(ref, 1.0, labels, base.Data(), 0.5f, kBand, {}, 1.0f, &volume);
+  }
+  state.counters["Mpixel_labels/s"] = benchmark::Counter(
+      1e-6 * kWidth * kHeight * kBand, benchmark::Counter::kIsIterationInvariantRate);
+}
+BENCHMARK(BM_GeometricPrior)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 }  // namespace hairmvs

@@ -19,11 +19,18 @@ inline float3 MatVec(__global const float* m, float3 x) {
                   m[6] * x.x + m[7] * x.y + m[8] * x.z);
 }
 
-// Global size (width, height, num_labels).
+// Labels per work-item: the quantities of a pixel and a view that do not depend on the depth are
+// computed once for them.
+#define LABEL_CHUNK 16
+
+// Global size (width, height, ceil(num_labels / LABEL_CHUNK)). Per pixel p and view j, with
+// r = K_ref^-1 (col + 0.5, row + 0.5, 1) (so X = D r): X_j = D (A r) + a, its projection
+// K_j X_j = D (K_j A r) + K_j a, and j's surface S projected back by K_ref:
+// K_ref S = K_ref C + (D (col + 0.5, row + 0.5, 1) - K_ref C) depth_j / X_j.z.
 __kernel void geometric_prior(int width, int height, __global const float* ref_params,
                               __global const float* depth_maps,
                               __global const float* view_params,
-                              __global const int* view_dims, int num_views,
+                              __global const int* view_dims, int num_views, int num_labels,
                               __global const float* label_base, int has_base,
                               __global const uchar* active, int has_active, float label_step,
                               float depth_a, float depth_b, int inverse_depth,
@@ -31,39 +38,52 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
                               float per_view_weight, __global float* volume) {
   const int col = get_global_id(0);
   const int row = get_global_id(1);
-  const int k = get_global_id(2);
+  const int k0 = get_global_id(2) * LABEL_CHUNK;
   if (col >= width || row >= height) return;
   const int p = row * width + col;
   if (has_active && !active[p]) return;
-  const float v = (has_base ? label_base[p] : 0.0f) + (float)k * label_step;
-  const float t = depth_a + depth_b * v;
-  const float depth = inverse_depth ? 1.0f / t : t;
+  const int count = min(LABEL_CHUNK, num_labels - k0);
+  const float base = has_base ? label_base[p] : 0.0f;
+  float depth[LABEL_CHUNK], total[LABEL_CHUNK];
+  for (int i = 0; i < count; ++i) {
+    const float t = depth_a + depth_b * (base + (float)(k0 + i) * label_step);
+    depth[i] = inverse_depth ? 1.0f / t : t;
+    total[i] = 0.0f;
+  }
   const float2 centre = (float2)((float)col + 0.5f, (float)row + 0.5f);
-  const float3 x = depth * MatVec(ref_params, (float3)(centre, 1.0f));
-  float total = 0.0f;
+  const float3 pixel = (float3)(centre, 1.0f);
+  const float3 ray = MatVec(ref_params, pixel);
   for (int j = 0; j < num_views; ++j) {
     __global const float* params = view_params + 24 * j;
-    float error = max_error_px;
-    const float3 xj = MatVec(params, x) + (float3)(params[9], params[10], params[11]);
-    if (xj.z > 0.0f) {
-      const float3 uvw = MatVec(params + 12, xj);
-      const float u = uvw.x / uvw.z, w = uvw.y / uvw.z;
-      const int map_width = view_dims[4 * j], map_height = view_dims[4 * j + 1];
-      if (u >= 0.0f && w >= 0.0f && u < (float)map_width && w < (float)map_height) {
-        const float map_depth =
-            depth_maps[view_dims[4 * j + 2] + (int)w * map_width + (int)u];
-        if (map_depth > 0.0f) {
-          const float3 c = (float3)(params[21], params[22], params[23]);
-          const float3 s = c + (x - c) * (map_depth / xj.z);
-          const float3 back = MatVec(ref_params + 9, s);
-          if (back.z > 0.0f) {
-            const float e = length(back.xy / back.z - centre) * level0_px_per_grid_px;
-            error = min(e, max_error_px);
+    const float3 a = (float3)(params[9], params[10], params[11]);
+    const float3 a_ray = MatVec(params, ray);
+    const float3 k_a_ray = MatVec(params + 12, a_ray);
+    const float3 k_a = MatVec(params + 12, a);
+    const float3 k_ref_c = MatVec(ref_params + 9, (float3)(params[21], params[22], params[23]));
+    const int map_width = view_dims[4 * j], map_height = view_dims[4 * j + 1];
+    __global const float* map = depth_maps + view_dims[4 * j + 2];
+    for (int i = 0; i < count; ++i) {
+      const float d = depth[i];
+      float error = max_error_px;
+      const float xj_z = d * a_ray.z + a.z;
+      if (xj_z > 0.0f) {
+        const float3 uvw = d * k_a_ray + k_a;
+        const float u = uvw.x / uvw.z, w = uvw.y / uvw.z;
+        if (u >= 0.0f && w >= 0.0f && u < (float)map_width && w < (float)map_height) {
+          const float map_depth = map[(int)w * map_width + (int)u];
+          if (map_depth > 0.0f) {
+            const float3 back = k_ref_c + (d * pixel - k_ref_c) * (map_depth / xj_z);
+            if (back.z > 0.0f) {
+              const float e = length(back.xy / back.z - centre) * level0_px_per_grid_px;
+              error = min(e, max_error_px);
+            }
           }
         }
       }
+      total[i] += error;
     }
-    total += error;
   }
-  volume[k * width * height + p] += per_view_weight * total / max_error_px;
+  for (int i = 0; i < count; ++i) {
+    volume[(size_t)(k0 + i) * width * height + p] += per_view_weight * total[i] / max_error_px;
+  }
 }

@@ -10,6 +10,11 @@
 
 namespace hairmvs {
 
+namespace {
+// Labels per work-item (LABEL_CHUNK in kernels/geometric_prior.cl).
+constexpr int kLabelChunk = 16;
+}  // namespace
+
 GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior& prior)
     : context_(context),
       num_views_(static_cast<int>(prior.views.size())),
@@ -79,6 +84,7 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   k.setArg(arg++, params_buffer);
   k.setArg(arg++, view_dims_);
   k.setArg(arg++, num_views_);
+  k.setArg(arg++, num_labels);
   k.setArg(arg++, base_buffer);
   k.setArg(arg++, base.empty() ? 0 : 1);
   k.setArg(arg++, active_buffer);
@@ -92,7 +98,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   k.setArg(arg++, per_view);
   k.setArg(arg++, volume_buffer);
   cl::CommandQueue& queue = context_->Queue();
-  queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width, height, num_labels));
+  const int num_chunks = (num_labels + kLabelChunk - 1) / kLabelChunk;
+  queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width, height, num_chunks));
   void* mapped = queue.enqueueMapBuffer(volume_buffer, CL_TRUE, CL_MAP_READ, 0,
                                         sizeof(float) * volume->size());
   CHECK(mapped == volume->data());  // USE_HOST_PTR: the map is the host memory, up to date

@@ -106,7 +106,10 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   for (bool with_base : {true, false}) {
     const std::vector<float> label_base = with_base ? base : std::vector<float>();
     const std::vector<uint8_t> pixels = with_base ? active : std::vector<uint8_t>();
-    const float step = with_base ? 0.75f : 5.0f;  // without a base: labels 0 to 55
+    // Without a base: labels 0 to 52.8. (A step of 5 put label 35's depth, 0.857 m, where the
+    // third view sees grid column 37 exactly on its pixel border u = 40, in exact arithmetic:
+    // any single-precision kernel then reads one side or the other of that whole column.)
+    const float step = with_base ? 0.75f : 4.8f;
     std::vector<float> expected(n * num_labels, 0.25f), got = expected;
     AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f,
                          &expected);
