@@ -59,69 +59,86 @@ inline float Bilinear1(__global const float* plane, int w, int h, float x, float
          (1.0f - fx) * fy * plane[y1 * w + x0] + fx * fy * plane[y1 * w + x1];
 }
 
-// Global size (width, height, num_slices).
+// Slices per work-item of orientation_cost: what does not depend on the depth (the pixel's
+// projection direction and carried strand direction in each view) is computed once for them.
+#define SLICE_CHUNK 8
+
+// Global size (width, height, ceil(num_slices / SLICE_CHUNK)).
 __kernel void orientation_cost(__global const float* ref, int width, int height,
                                __global const float* source, __global const float* view_params,
                                __global const int* view_dims, int num_views,
                                __global const float* label_base, float label_step,
-                               int slice_begin, float depth_a, float depth_b, int inverse_depth,
-                               __global float* cost, __global const float* log_depth_gradient,
-                               int has_gradient) {
+                               int slice_begin, int num_slices, float depth_a, float depth_b,
+                               int inverse_depth, __global float* cost,
+                               __global const float* log_depth_gradient, int has_gradient) {
   const int col = get_global_id(0);
   const int row = get_global_id(1);
-  const int k = get_global_id(2);
+  const int k0 = get_global_id(2) * SLICE_CHUNK;
   if (col >= width || row >= height) return;
   const int p = row * width + col;
   const int plane = width * height;
-  const float gx = has_gradient ? log_depth_gradient[p] : 0.0f;
-  const float gy = has_gradient ? log_depth_gradient[plane + p] : 0.0f;
+  const int count = min(SLICE_CHUNK, num_slices - k0);
   const float ore = ref[p];
   const float oim = ref[plane + p];
-  float total = 0.0f;
+  float total[SLICE_CHUNK];
+  for (int i = 0; i < count; ++i) total[i] = 0.0f;
   if (ore != 0.0f || oim != 0.0f) {
-    const float v = label_base[p] + (float)(slice_begin + k) * label_step;
-    const float depth = SampleDepth(v, depth_a, depth_b, inverse_depth);
+    float depth[SLICE_CHUNK];
+    for (int i = 0; i < count; ++i) {
+      const float v = label_base[p] + (float)(slice_begin + k0 + i) * label_step;
+      depth[i] = SampleDepth(v, depth_a, depth_b, inverse_depth);
+    }
+    const float gx = has_gradient ? log_depth_gradient[p] : 0.0f;
+    const float gy = has_gradient ? log_depth_gradient[plane + p] : 0.0f;
     const float x = (float)col + 0.5f;
     const float y = (float)row + 0.5f;
+    // O_ref = r exp(2i theta) and the strand direction (ct, st) = (cos theta, sin theta).
+    const float r = sqrt(ore * ore + oim * oim);
+    const float c2 = ore / r;
+    const float ct = sqrt(fmax(0.0f, 0.5f * (1.0f + c2)));
+    const float st = copysign(sqrt(fmax(0.0f, 0.5f * (1.0f - c2))), oim);
+    // The strand's plane tilts by the gradient g of log depth (plane_homography).
+    const float kappa = gx * ct + gy * st;
     for (int j = 0; j < num_views; ++j) {
       __global const float* m = view_params + 16 * j;
-      const float ux = depth * (m[0] * x + m[1] * y + m[2]) + m[9];
-      const float uy = depth * (m[3] * x + m[4] * y + m[5]) + m[10];
-      const float uz = depth * (m[6] * x + m[7] * y + m[8]) + m[11];
-      if (uz <= 0.0f) continue;
+      // The pixel's ray through H: the projection is u = D * (hpx, hpy, hpz) + b.
+      const float hpx = m[0] * x + m[1] * y + m[2];
+      const float hpy = m[3] * x + m[4] * y + m[5];
+      const float hpz = m[6] * x + m[7] * y + m[8];
+      // The strand direction H ((ct, st, 0) + kappa (x, y, 1)), before the Jacobian of the
+      // division by u.z, which depends on the depth.
+      const float hx = m[0] * ct + m[1] * st + kappa * hpx;
+      const float hy = m[3] * ct + m[4] * st + kappa * hpy;
+      const float hz = m[6] * ct + m[7] * st + kappa * hpz;
       const int w = view_dims[4 * j];
       const int h = view_dims[4 * j + 1];
       __global const float* src = source + view_dims[4 * j + 2];
-      int valid;
-      const float2 o = Bilinear2(src, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
-      if (!valid) continue;
-      if (m[14] != 0.0f) {
-        // O_ref = r exp(2i theta): the direction (cos theta, sin theta) through the Jacobian
-        // (up to a positive factor) gives theta' and the carried O' = r exp(2i theta').
-        const float px = ux / uz, py = uy / uz;
-        const float r = sqrt(ore * ore + oim * oim);
-        const float c2 = ore / r;
-        const float ct = sqrt(fmax(0.0f, 0.5f * (1.0f + c2)));
-        const float st = copysign(sqrt(fmax(0.0f, 0.5f * (1.0f - c2))), oim);
-        // The strand's plane tilts by the gradient g of log depth: direction H ((ct, st, 0) +
-        // (g . (ct, st)) (x, y, 1)), then the Jacobian of the division by u.z.
-        const float kappa = gx * ct + gy * st;
-        const float hx = m[0] * ct + m[1] * st + kappa * (m[0] * x + m[1] * y + m[2]);
-        const float hy = m[3] * ct + m[4] * st + kappa * (m[3] * x + m[4] * y + m[5]);
-        const float hz = m[6] * ct + m[7] * st + kappa * (m[6] * x + m[7] * y + m[8]);
-        const float dx = hx - px * hz;
-        const float dy = hy - py * hz;
-        const float scale = r / (dx * dx + dy * dy);
-        total -= scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
-      } else {
-        // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
-        const float re = ore * o.x + oim * o.y;
-        const float im = ore * o.y - oim * o.x;
-        total -= re * m[12] - im * m[13];
+      for (int i = 0; i < count; ++i) {
+        const float ux = depth[i] * hpx + m[9];
+        const float uy = depth[i] * hpy + m[10];
+        const float uz = depth[i] * hpz + m[11];
+        if (uz <= 0.0f) continue;
+        int valid;
+        const float2 o = Bilinear2(src, w, h, ux / uz - 0.5f, uy / uz - 0.5f, &valid);
+        if (!valid) continue;
+        if (m[14] != 0.0f) {
+          // The direction through the Jacobian (up to a positive factor) gives theta' and the
+          // carried O' = r exp(2i theta').
+          const float px = ux / uz, py = uy / uz;
+          const float dx = hx - px * hz;
+          const float dy = hy - py * hz;
+          const float scale = r / (dx * dx + dy * dy);
+          total[i] -= scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
+        } else {
+          // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
+          const float re = ore * o.x + oim * o.y;
+          const float im = ore * o.y - oim * o.x;
+          total[i] -= re * m[12] - im * m[13];
+        }
       }
     }
   }
-  cost[(size_t)k * plane + p] = total;
+  for (int i = 0; i < count; ++i) cost[(size_t)(k0 + i) * plane + p] = total[i];
 }
 
 // Photometric baseline, step 1: for one source view, the warped colour and the products whose

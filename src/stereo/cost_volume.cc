@@ -14,6 +14,9 @@ namespace {
 
 cl::Program& CostProgram(OpenCLContext* context) { return context->Program({"cost_volume.cl"}); }
 
+// Slices per work-item of orientation_cost (SLICE_CHUNK in kernels/cost_volume.cl).
+constexpr int kOrientationSliceChunk = 8;
+
 // Bilinear sample with pixel centres at integers; false outside [0, w-1] x [0, h-1].
 bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double* value) {
   const int w = map.Width(), h = map.Height();
@@ -141,14 +144,16 @@ void CostVolumeCL::Compute(const cl::Buffer& label_base, float label_step, int s
   k.setArg(a++, label_base);
   k.setArg(a++, label_step);
   k.setArg(a++, slice_begin);
+  k.setArg(a++, num_slices);
   k.setArg(a++, static_cast<float>(labels.a));
   k.setArg(a++, static_cast<float>(labels.b));
   k.setArg(a++, static_cast<int>(labels.inverse));
   k.setArg(a++, out);
   k.setArg(a++, log_depth_gradient_);
   k.setArg(a++, has_gradient_);
+  const int num_chunks = (num_slices + kOrientationSliceChunk - 1) / kOrientationSliceChunk;
   context_->Queue().enqueueNDRangeKernel(k, cl::NullRange,
-                                         cl::NDRange(width_, height_, num_slices));
+                                         cl::NDRange(width_, height_, num_chunks));
 }
 
 void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_step,
