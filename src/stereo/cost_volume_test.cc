@@ -71,6 +71,12 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
                                                  OrientationTransfer::kPlaneHomography);
   EXPECT_LT(MaxAbsDiff(tilted_volume.Compute(tilted.base, 0.75f, 5, 7, labels), tilted_cpu),
             2e-4f);
+  // A block of more slices than a work-item takes (8 in kernels/cost_volume.cl): two whole
+  // chunks and a part of one.
+  EXPECT_LT(MaxAbsDiff(tilted_volume.Compute(tilted.base, 0.75f, 3, 19, labels),
+                       OrientationCostCpu(tilted.ref, tilted.sources, tilted.base, 0.75f, 3, 19,
+                                          labels, OrientationTransfer::kPlaneHomography)),
+            2e-4f);
   EXPECT_GT(MaxAbsDiff(tilted_cpu, plane), 0.05f);
   // Uniform-in-depth labels too.
   const DepthLabels linear(0.6, 2.0, 32, false);

@@ -99,17 +99,20 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   for (const FusionView& view : views) prior.views.push_back(&view);
   prior.weight = 2.0;
   prior.max_error_px = 6.0;
-  const int num_labels = 12;
+  // More labels than a work-item takes (16 in kernels/geometric_prior.cl): a whole chunk and
+  // a part of one.
+  const int num_labels = 20;
   // A mask of the pixels where the prior is added (about two thirds), with the base only.
   std::vector<uint8_t> active(n);
   for (uint8_t& a : active) a = unit(rng) < 0.67f;
   for (bool with_base : {true, false}) {
     const std::vector<float> label_base = with_base ? base : std::vector<float>();
     const std::vector<uint8_t> pixels = with_base ? active : std::vector<uint8_t>();
-    // Without a base: labels 0 to 52.8. (A step of 5 put label 35's depth, 0.857 m, where the
-    // third view sees grid column 37 exactly on its pixel border u = 40, in exact arithmetic:
-    // any single-precision kernel then reads one side or the other of that whole column.)
-    const float step = with_base ? 0.75f : 4.8f;
+    // Without a base: labels 0 to 55.1. (With 12 labels 5 apart, label 35's depth, 0.857 m,
+    // put grid column 37 exactly on a pixel border of the third view, u = 40, in exact
+    // arithmetic: a single-precision kernel then reads one side or the other of the whole
+    // column.)
+    const float step = with_base ? 0.75f : 2.9f;
     std::vector<float> expected(n * num_labels, 0.25f), got = expected;
     AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f,
                          &expected);
