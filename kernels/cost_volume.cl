@@ -59,9 +59,12 @@ inline float Bilinear1(__global const float* plane, int w, int h, float x, float
          (1.0f - fx) * fy * plane[y1 * w + x0] + fx * fy * plane[y1 * w + x1];
 }
 
-// Slices per work-item of orientation_cost: what does not depend on the depth (the pixel's
-// projection direction and carried strand direction in each view) is computed once for them.
-#define SLICE_CHUNK 8
+// SLICE_CHUNK (build option): slices per work-item of orientation_cost; what does not depend on
+// the depth (the pixel's projection direction and carried strand direction in each view) is
+// computed once for them.
+#ifndef SLICE_CHUNK
+#error "SLICE_CHUNK must be defined"
+#endif
 
 // Global size (width, height, ceil(num_slices / SLICE_CHUNK)).
 __kernel void orientation_cost(__global const float* ref, int width, int height,

@@ -19,9 +19,11 @@ inline float3 MatVec(__global const float* m, float3 x) {
                   m[6] * x.x + m[7] * x.y + m[8] * x.z);
 }
 
-// Labels per work-item: the quantities of a pixel and a view that do not depend on the depth are
-// computed once for them.
-#define LABEL_CHUNK 16
+// LABEL_CHUNK (build option): labels per work-item; the quantities of a pixel and a view that do
+// not depend on the depth are computed once for them.
+#ifndef LABEL_CHUNK
+#error "LABEL_CHUNK must be defined"
+#endif
 
 // Global size (width, height, ceil(num_labels / LABEL_CHUNK)). Per pixel p and view j, with
 // r = K_ref^-1 (col + 0.5, row + 0.5, 1) (so X = D r): X_j = D (A r) + a, its projection

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <string>
 
 #include "src/core/logging.h"
 #include "src/opencl/opencl_context.h"
@@ -12,10 +13,13 @@ namespace hairmvs {
 
 namespace {
 
-cl::Program& CostProgram(OpenCLContext* context) { return context->Program({"cost_volume.cl"}); }
-
 // Slices per work-item of orientation_cost (SLICE_CHUNK in kernels/cost_volume.cl).
 constexpr int kOrientationSliceChunk = 8;
+
+cl::Program& CostProgram(OpenCLContext* context) {
+  return context->Program({"cost_volume.cl"},
+                          "-D SLICE_CHUNK=" + std::to_string(kOrientationSliceChunk));
+}
 
 // Bilinear sample with pixel centres at integers; false outside [0, w-1] x [0, h-1].
 bool SampleBilinear(const FloatMap& map, int channel, double x, double y, double* value) {

@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <array>
+#include <string>
 
 #include "src/core/logging.h"
 #include "src/opencl/opencl_context.h"
@@ -20,7 +21,9 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
       num_views_(static_cast<int>(prior.views.size())),
       weight_(prior.weight),
       max_error_px_(prior.max_error_px),
-      kernel_(context->Program({"geometric_prior.cl"}), "geometric_prior") {
+      kernel_(context->Program({"geometric_prior.cl"},
+                               "-D LABEL_CHUNK=" + std::to_string(kLabelChunk)),
+              "geometric_prior") {
   std::vector<float> maps;
   std::vector<int> dims;
   for (const FusionView* view : prior.views) {
