@@ -10,7 +10,6 @@
 namespace hairmvs {
 namespace {
 
-int RoundUp(int value, int multiple) { return (value + multiple - 1) / multiple * multiple; }
 
 void CheckInputs(const FloatMap& gray, const FloatMap& mask) {
   THROW_IF(gray.Empty() || gray.Channels() != 1,
@@ -175,7 +174,7 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
   const int w = gray.Width(), h = gray.Height();
   const int vec = config_.vector_width;
   const int pad = bank_.Radius();
-  const int out_stride = RoundUp(w, vec);
+  const int out_stride = static_cast<int>(RoundUpToMultiple(w, vec));
   const int padded_stride = out_stride + 2 * pad;
   const int padded_rows = h + 2 * pad;
 
@@ -249,8 +248,8 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     k.setArg(arg++, static_cast<float>(options_.confidence_gamma));
     k.setArg(arg++, static_cast<float>(options_.min_positive_response_ratio));
     const cl::NDRange local(config_.local_size_x, config_.local_size_y);
-    const cl::NDRange global(RoundUp(out_stride / vec, config_.local_size_x),
-                             RoundUp(h, config_.local_size_y));
+    const cl::NDRange global(RoundUpToMultiple(out_stride / vec, config_.local_size_x),
+                             RoundUpToMultiple(h, config_.local_size_y));
     queue.enqueueNDRangeKernel(k, cl::NullRange, global, local);
     queue.finish();
   }

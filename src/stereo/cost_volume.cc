@@ -155,9 +155,9 @@ void CostVolumeCL::Compute(const cl::Buffer& label_base, float label_step, int s
   k.setArg(a++, out);
   k.setArg(a++, log_depth_gradient_);
   k.setArg(a++, has_gradient_);
-  const int num_chunks = (num_slices + kOrientationSliceChunk - 1) / kOrientationSliceChunk;
-  context_->Queue().enqueueNDRangeKernel(k, cl::NullRange,
-                                         cl::NDRange(width_, height_, num_chunks));
+  context_->Queue().enqueueNDRangeKernel(
+      k, cl::NullRange,
+      cl::NDRange(width_, height_, DivideRoundingUp(num_slices, kOrientationSliceChunk)));
 }
 
 void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_step,

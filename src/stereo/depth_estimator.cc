@@ -689,8 +689,7 @@ constexpr int kCropSizeMultiple = 32;
 void CropAxis(int first, int last, int length, int margin, int align, int* start, int* size) {
   const int begin = std::max(0, (first - margin) / align * align);
   const int end = std::min(length, last + 1 + margin);
-  const int rounded =
-      (end - begin + kCropSizeMultiple - 1) / kCropSizeMultiple * kCropSizeMultiple;
+  const int rounded = static_cast<int>(RoundUpToMultiple(end - begin, kCropSizeMultiple));
   *start = begin;
   *size = rounded;
   if (begin + rounded > length) {  // moved back from the edge, keeping the alignment

@@ -101,8 +101,8 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   k.setArg(arg++, per_view);
   k.setArg(arg++, volume_buffer);
   cl::CommandQueue& queue = context_->Queue();
-  const int num_chunks = (num_labels + kLabelChunk - 1) / kLabelChunk;
-  queue.enqueueNDRangeKernel(k, cl::NullRange, cl::NDRange(width, height, num_chunks));
+  queue.enqueueNDRangeKernel(k, cl::NullRange,
+                             cl::NDRange(width, height, DivideRoundingUp(num_labels, kLabelChunk)));
   void* mapped = queue.enqueueMapBuffer(volume_buffer, CL_TRUE, CL_MAP_READ, 0,
                                         sizeof(float) * volume->size());
   CHECK(mapped == volume->data());  // USE_HOST_PTR: the map is the host memory, up to date

@@ -48,7 +48,7 @@ void BoxFilterCL::Mean(const cl::Buffer& in, const cl::Buffer& scratch, const cl
   cols_.setArg(3, height);
   cols_.setArg(4, radius);
   // box_cols: a work-item per 8 columns.
-  EnqueueLines(context_->Queue(), cols_, (width + 7) / 8, num_planes, kLineGroup);
+  EnqueueLines(context_->Queue(), cols_, DivideRoundingUp(width, 8), num_planes, kLineGroup);
 }
 
 GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, int radius,
