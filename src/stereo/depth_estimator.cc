@@ -717,17 +717,15 @@ GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
   return crop;
 }
 
-// Level `level` of a pyramid (orientation fields or colours) cropped as `crop` is at level 0.
-FloatMap CropLevel(const FloatMap& map, const GridCrop& crop, int level) {
-  int width = crop.width, height = crop.height;
-  for (int l = 0; l < level; ++l) {
-    width = (width + 1) / 2;
-    height = (height + 1) / 2;
-  }
+// Level `level` of a pyramid (orientation fields or colours) cropped as `crop` is at level 0,
+// to the size of that level of the cropped camera `part`.
+FloatMap CropLevel(const FloatMap& map, const GridCrop& crop, const StereoCamera& part,
+                   int level) {
+  const StereoCamera grid = part.PyramidLevel(level);
   const int x0 = crop.x0 >> level, y0 = crop.y0 >> level;
-  CHECK_LE(x0 + width, map.Width());
-  CHECK_LE(y0 + height, map.Height());
-  return CropFloatMap(map, x0, y0, width, height);
+  CHECK_LE(x0 + grid.width, map.Width());
+  CHECK_LE(y0 + grid.height, map.Height());
+  return CropFloatMap(map, x0, y0, grid.width, grid.height);
 }
 
 }  // namespace
@@ -765,18 +763,19 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   part.camera.K(1, 2) -= crop.y0;
   part.camera.width = crop.width;
   part.camera.height = crop.height;
-  for (size_t l = 0; l < ref.orientation.size(); ++l) {
-    part.orientation.push_back(CropLevel(ref.orientation[l], crop, static_cast<int>(l)));
-  }
-  for (size_t l = 0; l < ref.matching.size(); ++l) {
-    part.matching.push_back(CropLevel(ref.matching[l], crop, static_cast<int>(l)));
-  }
-  for (size_t l = 0; l < ref.rgb.size(); ++l) {
-    part.rgb.push_back(CropLevel(ref.rgb[l], crop, static_cast<int>(l)));
-  }
-  const FloatMap part_mask = CropLevel(mask, crop, 0);
+  auto crop_pyramid = [&](const std::vector<FloatMap>& pyramid) {
+    std::vector<FloatMap> levels;
+    for (size_t l = 0; l < pyramid.size(); ++l) {
+      levels.push_back(CropLevel(pyramid[l], crop, part.camera, static_cast<int>(l)));
+    }
+    return levels;
+  };
+  part.orientation = crop_pyramid(ref.orientation);
+  part.matching = crop_pyramid(ref.matching);
+  part.rgb = crop_pyramid(ref.rgb);
+  const FloatMap part_mask = CropLevel(mask, crop, part.camera, 0);
   const FloatMap part_hull =
-      visual_hull_entry.Empty() ? FloatMap() : CropLevel(visual_hull_entry, crop, 0);
+      visual_hull_entry.Empty() ? FloatMap() : CropLevel(visual_hull_entry, crop, part.camera, 0);
   DepthEstimate estimate =
       EstimateDepthMapOnGrid(context, part, sources, part_mask, part_hull, labels, options,
                              timings, progress, prior, coarse_volume_cache);

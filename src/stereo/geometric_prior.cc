@@ -70,7 +70,7 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   cl::Buffer ref_buffer = ReadOnlyBuffer(context_, ref_params);
   cl::Buffer params_buffer = ReadOnlyBuffer(context_, view_params);
   cl::Buffer base_buffer = base.empty() ? ReadOnlyBuffer(context_, &no_base, sizeof(float))
-                                        : ReadOnlyBuffer(context_, base.data(), sizeof(float) * n);
+                                        : ReadOnlyBuffer(context_, base);
   cl::Buffer active_buffer = active.empty() ? ReadOnlyBuffer(context_, &all_active, 1)
                                             : ReadOnlyBuffer(context_, active);
   // The host volume itself (a CPU device adds in place; another copies it there and back).
