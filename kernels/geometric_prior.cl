@@ -5,14 +5,15 @@
 // e_j COLMAP's forward-backward reprojection error through view j's depth map (in level-0
 // pixels: the grid's error times level0_px_per_grid_px), max_error_px where view j does not see
 // the point or has no depth there.
-// All in the reference camera's frame: X = D * K_ref^-1 (col + 0.5, row + 0.5, 1).
-// view_params, per view (24 floats): A (9, row-major), a (3) with X_j = A X + a the point in
-// view j's camera frame; K_j (9, row-major); C (3), view j's centre in the reference's frame.
+// All in the reference camera's frame: X = D * K_ref^-1 (col + 0.5, row + 0.5, 1), and
+// X_j = A X + a the point in view j's camera frame, C view j's centre in the reference's frame.
+// view_params, per view (20 floats): K_j A (9, row-major), the last row of A (3), K_j a (3),
+// a.z (1), K_ref C (3), 0.
 // view_dims, per view (4 ints): width and height of j's depth map, offset of the map in
 // depth_maps, 0. A point is seen when X_j.z > 0 and its projection (SfM convention: pixel
 // (c, r) covers [c, c+1) x [r, r+1)) falls inside the map; j's surface on the ray is
 // S = C + (X - C) * depth_j / X_j.z, projected back by K_ref.
-// ref_params (18 floats): K_ref^-1, K_ref (row-major).
+// ref_params (9 floats): K_ref^-1 (row-major).
 
 inline float3 MatVec(__global const float* m, float3 x) {
   return (float3)(m[0] * x.x + m[1] * x.y + m[2] * x.z, m[3] * x.x + m[4] * x.y + m[5] * x.z,
@@ -56,18 +57,18 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
   const float3 pixel = (float3)(centre, 1.0f);
   const float3 ray = MatVec(ref_params, pixel);
   for (int j = 0; j < num_views; ++j) {
-    __global const float* params = view_params + 24 * j;
-    const float3 a = (float3)(params[9], params[10], params[11]);
-    const float3 a_ray = MatVec(params, ray);
-    const float3 k_a_ray = MatVec(params + 12, a_ray);
-    const float3 k_a = MatVec(params + 12, a);
-    const float3 k_ref_c = MatVec(ref_params + 9, (float3)(params[21], params[22], params[23]));
+    __global const float* params = view_params + 20 * j;
+    const float3 k_a_ray = MatVec(params, ray);
+    const float a_ray_z = params[9] * ray.x + params[10] * ray.y + params[11] * ray.z;
+    const float3 k_a = (float3)(params[12], params[13], params[14]);
+    const float a_z = params[15];
+    const float3 k_ref_c = (float3)(params[16], params[17], params[18]);
     const int map_width = view_dims[4 * j], map_height = view_dims[4 * j + 1];
     __global const float* map = depth_maps + view_dims[4 * j + 2];
     for (int i = 0; i < count; ++i) {
       const float d = depth[i];
       float error = max_error_px;
-      const float xj_z = d * a_ray.z + a.z;
+      const float xj_z = d * a_ray_z + a_z;
       if (xj_z > 0.0f) {
         const float3 uvw = d * k_a_ray + k_a;
         const float u = uvw.x / uvw.z, w = uvw.y / uvw.z;

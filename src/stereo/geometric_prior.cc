@@ -48,22 +48,26 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   CHECK(active.empty() || active.size() == n);
   // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
   // precision keeps the errors to about 1e-4 px.
+  // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
+  // precision keeps the errors to about 1e-4 px; what depends on a view only is computed here.
   const Eigen::Matrix3d R_t = grid_camera.R.transpose();
-  std::array<float, 18> ref_params;
+  std::array<float, 9> ref_params;
   const Eigen::Matrix3d K_inv = grid_camera.K.inverse();
-  for (int i = 0; i < 9; ++i) {
-    ref_params[i] = static_cast<float>(K_inv(i / 3, i % 3));
-    ref_params[9 + i] = static_cast<float>(grid_camera.K(i / 3, i % 3));
-  }
+  for (int i = 0; i < 9; ++i) ref_params[i] = static_cast<float>(K_inv(i / 3, i % 3));
   std::vector<float> view_params;
   for (const ViewCamera& view : cameras_) {
     const Eigen::Matrix3d A = view.R * R_t;
     const Eigen::Vector3d a = view.t - A * grid_camera.t;
     const Eigen::Vector3d centre = grid_camera.R * (-view.R.transpose() * view.t) + grid_camera.t;
-    for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(A(i / 3, i % 3)));
-    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(a(i)));
-    for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(view.K(i / 3, i % 3)));
-    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(centre(i)));
+    const Eigen::Matrix3d KA = view.K * A;
+    const Eigen::Vector3d Ka = view.K * a;
+    const Eigen::Vector3d K_ref_centre = grid_camera.K * centre;
+    for (int i = 0; i < 9; ++i) view_params.push_back(static_cast<float>(KA(i / 3, i % 3)));
+    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(A(2, i)));
+    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(Ka(i)));
+    view_params.push_back(static_cast<float>(a(2)));
+    for (int i = 0; i < 3; ++i) view_params.push_back(static_cast<float>(K_ref_centre(i)));
+    view_params.push_back(0.0f);
   }
   const float no_base = 0.0f;
   const uint8_t all_active = 1;
