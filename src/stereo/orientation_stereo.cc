@@ -770,10 +770,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         K = estimated_again->second.K;
         stats = estimated_again->second.stats;
       } else if (others.empty()) {
-        LOG(WARNING) << name << ": no view it is checked against (its sources) has a "
-                     << ".photometric depth map yet; its .geometric map is unfiltered (run "
-                     << "again with --OrientationStereo.geom_consistency_only 1 when all views "
-                     << "are done)";
+        LOG(WARNING) << name << ": none of the views it is checked against (its sources and "
+                     << "the run's views looking the same way) has a .photometric depth map "
+                     << "yet; its .geometric map is unfiltered (run again with "
+                     << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
         depth = maps.ref->depth;
         filtered = false;
       } else {
