@@ -101,7 +101,7 @@ void BM_GeometricPrior(benchmark::State& state) {
   const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 0.6}, 768, kWidth, kHeight);
   std::vector<FusionView> views;
   for (int v = 0; v < 8; ++v) {
-    const double angle = 2 * 3.14159265358979 * v / 8;
+    const double angle = 2 * M_PI * v / 8;
     const StereoCamera camera = LookAtCamera(
         {0.1 * std::cos(angle), 0.1 * std::sin(angle), 0}, {0, 0, 0.6}, 768, kWidth, kHeight);
     FusionView view;
