@@ -10,7 +10,6 @@
 namespace hairmvs {
 namespace {
 
-
 void CheckInputs(const FloatMap& gray, const FloatMap& mask) {
   THROW_IF(gray.Empty() || gray.Channels() != 1,
            "Orientation field: expected a non-empty 1-channel grey image, got "

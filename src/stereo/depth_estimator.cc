@@ -745,16 +745,16 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   const int width0 = ref.orientation[0].Width(), height0 = ref.orientation[0].Height();
   CHECK_EQ(mask.Width(), width0);
   CHECK_EQ(mask.Height(), height0);
-  const size_t num_levels =
+  const size_t num_pyramid_levels =
       std::max({ref.orientation.size(), ref.matching.size(), ref.rgb.size()});
   // Past the farthest any window reaches from a masked pixel: the aggregation's at every level
   // of the data term (in level-0 px), the final filter's (level 0's) and the colour cost's NCC
   // window; twice that, so that a window near the mask's edge sees what it saw on the whole grid.
   int reach = options.ncc_window_px / 2 + 1;
-  for (size_t l = 0; l < std::min<size_t>(num_levels, options.num_levels); ++l) {
+  for (size_t l = 0; l < std::min<size_t>(num_pyramid_levels, options.num_levels); ++l) {
     reach = std::max(reach, (options.WindowPx(static_cast<int>(l)) / 2 + 1) << l);
   }
-  const GridCrop crop = MaskCrop(mask, 2 * reach, 1 << (num_levels - 1));
+  const GridCrop crop = MaskCrop(mask, 2 * reach, 1 << (num_pyramid_levels - 1));
   if (crop.width == 0 || (crop.width == width0 && crop.height == height0)) return whole_grid();
 
   StereoViewData part;

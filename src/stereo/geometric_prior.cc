@@ -47,8 +47,6 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   CHECK(base.empty() || base.size() == n);
   CHECK(active.empty() || active.size() == n);
   // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
-  // precision keeps the errors to about 1e-4 px.
-  // Everything in the reference camera's frame (kernels/geometric_prior.cl), so that single
   // precision keeps the errors to about 1e-4 px; what depends on a view only is computed here.
   const Eigen::Matrix3d R_t = grid_camera.R.transpose();
   std::array<float, 9> ref_params;
