@@ -31,7 +31,10 @@ struct SourceViewOptions {
   // Measured (.geometric maps, 4 -> 6 -> 8): synth_handheld 74.5 -> 80.3 -> 81.7% covered,
   // per-pixel median 5.85 -> 5.75 -> 5.76 mm, 3D mean 2.68 -> 2.13 -> 2.13 mm, 95 -> 95 ->
   // 110 s; synth_straight_gantry's g0 and g3 groups (the only views that share points with
-  // another group) 4.45 -> 4.45 -> 4.43 mm.
+  // another group) 4.45 -> 4.45 -> 4.43 mm. Sources of the next group given by hand (a
+  // patch-match.cfg; g2_c alone, no geometric pass): its T group 4.02 mm, + g7_b (35 degrees
+  // away) 3.91, + g7_b, g7_c and g7_l 3.94; one source alone: g2_r 3.88, g2_l 4.35, g2_b
+  // (baseline along the hanging strands) 8.19 mm. Wider sources hardly help orientation.
   int max_num_source_views = 6;
   // COLMAP's PatchMatchStereo.min_triangulation_angle: 75th percentile of the shared points'
   // triangulation angles must reach this.

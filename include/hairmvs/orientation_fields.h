@@ -28,6 +28,11 @@ struct OrientationFieldOptions {
   // 2.39 mm, mean 3.71 -> 3.59 mm; a synthesised straight group at 1404 x 936: median 6.10 ->
   // 5.32 mm. The filter bank takes about 1.6x as long (4 views at 1404 x 936: 3.2 -> 5.2 s of
   // 64-69 s). Along: the paper's 4 px (8 px: handheld 9.97 mm, curly 2.61).
+  // Measured again on the final pipeline (603a8b0, `bash scripts/evaluate_stereo.sh SET OUT
+  // --OrientationField.sigma_across_inner_px 0.5 ...`, .geometric, per-pixel median), this ->
+  // the paper's 0.5 / 1 / 4 -> 0.5 / 1 / 8: synth_straight_gantry 4.32 -> 4.34 -> 4.29 mm,
+  // synth_handheld 5.41 -> 5.91 -> 6.07 mm (3D median 0.637 -> 0.785 -> 0.816 mm). The narrow
+  // filters win on the single view g2_c alone (4.02 -> 3.79 -> 3.72 mm) but not on the sets.
   double sigma_across_inner_px = 1.0;
   double sigma_across_outer_px = 2.0;
   double sigma_along_px = 4.0;
