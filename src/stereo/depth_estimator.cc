@@ -233,17 +233,23 @@ float MedianCostRange(const std::vector<float>& volume, size_t num_pixels, int n
 
 }  // namespace
 
-FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float eps) {
+FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float relative_eps) {
   CHECK_EQ(orientation.Channels(), 2);
   const int width = orientation.Width(), height = orientation.Height();
   const size_t n = orientation.NumPixels();
   // Means over the valid (non-zero) pixels of each window, so that mask borders do not bias.
   std::vector<float> valid(n), sq(n);
+  double num_valid = 0, total_sq = 0;
   for (size_t i = 0; i < n; ++i) {
     const float re = orientation.Channel(0)[i], im = orientation.Channel(1)[i];
     valid[i] = (re != 0.0f || im != 0.0f) ? 1.0f : 0.0f;
     sq[i] = re * re + im * im;
+    num_valid += valid[i];
+    total_sq += sq[i];
   }
+  // eps in units of the field's own mean |O|^2, so that the confidence's exponent and the
+  // images' contrast do not change what it damps.
+  const double eps = relative_eps * total_sq / std::max(1.0, num_valid);
   std::vector<double> count, sum_re, sum_im, sum_sq, table;
   BoxSums(valid.data(), width, height, radius, &count, &table);
   BoxSums(orientation.Channel(0), width, height, radius, &sum_re, &table);

@@ -328,6 +328,27 @@ void ExpectRefusedNaming(const OrientationStereoOptions& options, const std::str
   EXPECT_NE(error.find(option), std::string::npos) << error;
 }
 
+// The matching's normalisation and the confidence filter: a negative window radius, an eps
+// that is not positive (a window of one valid pixel has variance 0: the scale would be
+// infinite) and a negative confidence threshold are refused by name.
+TEST(OrientationStereoOptions, NormalizationAndConfidenceOptions) {
+  OrientationStereoOptions options;
+  options.orientation_normalization_radius_px = -1;
+  ExpectRefusedNaming(options, "orientation_normalization_radius_px");
+  for (double eps : {0.0, -1e-3}) {
+    options = OrientationStereoOptions();
+    options.orientation_normalization_eps = eps;
+    ExpectRefusedNaming(options, "orientation_normalization_eps");
+  }
+  options = OrientationStereoOptions();
+  options.min_confidence = -0.5;
+  ExpectRefusedNaming(options, "min_confidence");
+  options = OrientationStereoOptions();
+  options.orientation_normalization_radius_px = 0;  // the paper's raw fields
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+}
+
 // The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) and a
 // photometric weight outside [0, 1], fewer than one round of the geometric pass and a view angle
 // outside [0, 180] degrees are refused by name. The strands' plane follows the hull
@@ -501,11 +522,9 @@ TEST(ScaleToRms, NonZeroPixelsGetTheTargetRms) {
   EXPECT_EQ(ScaleToRms(zeros, 1.0).Data(), zeros.Data());
 }
 
-// The local normalisation against explicit window sums: zero mean and unit variance (up to
-// eps) over each window of valid pixels; masked (zero) pixels stay zero.
-TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {
-  const int width = 13, height = 9, radius = 2;
-  const float eps = 1e-3f;
+// A 13 x 9 field of pseudo-random values in [-0.5, 0.5), every 7th pixel masked (zero).
+FloatMap RandomOrientationField() {
+  const int width = 13, height = 9;
   FloatMap field(width, height, 2);
   uint32_t state = 12345;
   auto next = [&state] {
@@ -519,7 +538,27 @@ TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {
       field.At(r, c, 1) = masked ? 0.0f : next();
     }
   }
-  const FloatMap normalized = NormalizeOrientationField(field, radius, eps);
+  return field;
+}
+
+// The local normalisation against explicit window sums: zero mean and unit variance (up to
+// eps, relative_eps times the mean |O|^2 of the valid pixels) over each window of valid pixels;
+// masked (zero) pixels stay zero.
+TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {
+  const FloatMap field = RandomOrientationField();
+  const int width = field.Width(), height = field.Height(), radius = 2;
+  const float relative_eps = 0.5f;  // large, so that a wrong eps shows
+  double num_valid = 0, total_sq = 0;
+  for (int r = 0; r < height; ++r) {
+    for (int c = 0; c < width; ++c) {
+      const double re = field.At(r, c, 0), im = field.At(r, c, 1);
+      if (re == 0.0 && im == 0.0) continue;
+      num_valid += 1;
+      total_sq += re * re + im * im;
+    }
+  }
+  const double eps = relative_eps * total_sq / num_valid;
+  const FloatMap normalized = NormalizeOrientationField(field, radius, relative_eps);
   for (int r = 0; r < height; ++r) {
     for (int c = 0; c < width; ++c) {
       if (field.At(r, c, 0) == 0.0f && field.At(r, c, 1) == 0.0f) {
@@ -544,6 +583,24 @@ TEST(NormalizeOrientationField, MatchesExplicitWindowStatistics) {
       EXPECT_NEAR(normalized.At(r, c, 1), (field.At(r, c, 1) - mim) * scale, 1e-4);
     }
   }
+}
+
+// eps scales with the field: a field with every confidence 100 times smaller (another
+// confidence_gamma, or a darker photo) normalises to the same values.
+TEST(NormalizeOrientationField, IndependentOfTheFieldsScale) {
+  const FloatMap field = RandomOrientationField();
+  FloatMap small = field;
+  for (float& value : small.Data()) value *= 0.01f;
+  const FloatMap expected = NormalizeOrientationField(field, 2, 0.1f);
+  const FloatMap got = NormalizeOrientationField(small, 2, 0.1f);
+  ASSERT_EQ(got.Data().size(), expected.Data().size());
+  double max_difference = 0, max_value = 0;
+  for (size_t i = 0; i < got.Data().size(); ++i) {
+    max_difference = std::max(max_difference, std::abs(double(got.Data()[i]) - expected.Data()[i]));
+    max_value = std::max(max_value, std::abs(double(expected.Data()[i])));
+  }
+  EXPECT_GT(max_value, 0.5);
+  EXPECT_LT(max_difference, 1e-4 * max_value);
 }
 
 }  // namespace

@@ -162,6 +162,12 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "window_px_level* must be >= 1; ";
   }
   if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
+  if (orientation_normalization_radius_px < 0) {
+    e << "orientation_normalization_radius_px must be >= 0; ";
+  }
+  // A window of one valid pixel (or of equal ones) has variance 0: eps is all that divides.
+  if (!(orientation_normalization_eps > 0)) e << "orientation_normalization_eps must be > 0; ";
+  if (!(min_confidence >= 0)) e << "min_confidence must be >= 0; ";
   if (!(guide_rms >= 0)) e << "guide_rms must be >= 0; ";
   if (!(sigma_o > 0)) e << "sigma_o must be > 0; ";
   if (!(lambda >= 0)) e << "lambda must be >= 0; ";
