@@ -7,7 +7,10 @@
 # and the data term alone. Extra arguments go to orientation_stereo, e.g.
 #   bash scripts/evaluate_stereo.sh ../shared/data/synth_handheld out/hh_photo \
 #       --OrientationStereo.cost photometric
-# OUT must not exist yet. Needs the built tool (bash scripts/build.sh hairmvs).
+# OUT must not exist yet. Needs the built tool (bash scripts/build.sh hairmvs). The cost
+# volumes (about 20 MiB a view: 0.6 GB for synth_straight_gantry) are removed once the data
+# term is evaluated, so that a series of runs does not fill the disk; KEEP_COST_VOLUMES=1 keeps
+# them in OUT/stereo/cost_volumes.
 set -euo pipefail
 if [ $# -lt 2 ]; then
   echo "usage: $0 SET_DIR OUT_DIR [orientation_stereo options...]" >&2
@@ -41,6 +44,7 @@ seconds=$(( $(date +%s) - start ))
   --output_path "$OUT/stereo/evaluation_first_estimate" > "$OUT/evaluate_first_estimate.log" 2>&1
 "$HAIRMVS" evaluate_data_term --workspace_path "$OUT" --ground_truth_path "$SET/gt" \
   > "$OUT/evaluate_data_term.log" 2>&1
+if [ "${KEEP_COST_VOLUMES:-0}" != 1 ]; then rm -rf "$OUT/stereo/cost_volumes"; fi
 
 header=$(grep -m1 '^view ' "$OUT/evaluate_geometric.log")
 echo "orientation_stereo on $SET ($*): ${seconds} s wall," \

@@ -246,13 +246,13 @@ struct OrientationStereoOptions {
   int orientation_normalization_radius_px = 3;
   // Added to the local variance of the normalisation, as a fraction of the field's mean |O|^2
   // over its non-zero pixels (> 0), so that it damps the same windows whatever the confidence's
-  // exponent and the photos' contrast. It was absolute (1e-3) until 8428041's successor: the
-  // renders' mean |O|^2 is 0.008 (gantry) to 0.012 (handheld) with confidence_gamma 0.5, about
-  // ten times that, but with confidence_gamma 1 (mean 1e-4) it swamped the variance and the
-  // depths failed (g2_c alone 27.5 mm, 4.07 with 1e-8). Measured (absolute, .geometric,
-  // per-pixel median), 1e-2: synth_straight_gantry 4.32 -> 4.40 mm, 98.6 -> 97.7% covered;
-  // synth_handheld 5.41 -> 5.89 mm, 92.2 -> 87.7% (g2_c alone 4.02 -> 3.95); 1e-8 and 1e-4:
-  // g2_c alone 4.07.
+  // exponent and the photos' contrast. Until stop 22 it was absolute, 1e-3: about a tenth of
+  // the renders' mean |O|^2 (0.008 gantry, 0.012 handheld) with confidence_gamma 0.5, but ten
+  // times the mean with confidence_gamma 1, where it swamped the variance and the depths failed
+  // (g2_c alone, the T group's sources, no geometric pass: 27.5 mm; relative 0.1: 4.06).
+  // Measured (.geometric, per-pixel median): relative 0.1 synth_straight_gantry 98.6% / 4.32
+  // mm, synth_handheld 92.0% / 5.38 mm (absolute 1e-3: 98.6% / 4.32, 92.2% / 5.41); absolute
+  // 1e-2 97.7% / 4.40 and 87.7% / 5.89 mm.
   double orientation_normalization_eps = 0.1;
   // Photometric and combined costs: NCC window (px) at every level.
   int ncc_window_px = 7;
