@@ -57,7 +57,7 @@ void SmoothnessWeights(const FloatMap& orientation, double lambda, double sigma_
   }
 }
 
-FloatMap ScaleToRms(const FloatMap& field, double rms) {
+double MeanSquareOfNonZero(const FloatMap& field) {
   double sum_sq = 0;
   long count = 0;
   for (size_t i = 0; i < field.NumPixels(); ++i) {
@@ -66,9 +66,14 @@ FloatMap ScaleToRms(const FloatMap& field, double rms) {
     sum_sq += sq;
     count += sq > 0;
   }
+  return count == 0 ? 0.0 : sum_sq / count;
+}
+
+FloatMap ScaleToRms(const FloatMap& field, double rms) {
+  const double mean_sq = MeanSquareOfNonZero(field);
   FloatMap scaled = field;
-  if (count == 0) return scaled;
-  const float factor = static_cast<float>(rms / std::sqrt(sum_sq / count));
+  if (mean_sq == 0) return scaled;
+  const float factor = static_cast<float>(rms / std::sqrt(mean_sq));
   for (float& v : scaled.Data()) v *= factor;
   return scaled;
 }
@@ -239,17 +244,14 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
   const size_t n = orientation.NumPixels();
   // Means over the valid (non-zero) pixels of each window, so that mask borders do not bias.
   std::vector<float> valid(n), sq(n);
-  double num_valid = 0, total_sq = 0;
   for (size_t i = 0; i < n; ++i) {
     const float re = orientation.Channel(0)[i], im = orientation.Channel(1)[i];
     valid[i] = (re != 0.0f || im != 0.0f) ? 1.0f : 0.0f;
     sq[i] = re * re + im * im;
-    num_valid += valid[i];
-    total_sq += sq[i];
   }
   // eps in units of the field's own mean |O|^2, so that the confidence's exponent and the
   // images' contrast do not change what it damps.
-  const double eps = relative_eps * total_sq / std::max(1.0, num_valid);
+  const double eps = relative_eps * MeanSquareOfNonZero(orientation);
   std::vector<double> count, sum_re, sum_im, sum_sq, table;
   BoxSums(valid.data(), width, height, radius, &count, &table);
   BoxSums(orientation.Channel(0), width, height, radius, &sum_re, &table);

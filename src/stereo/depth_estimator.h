@@ -31,11 +31,15 @@ struct StereoViewData {
 
 // Local normalisation of an orientation field for matching: (O - mean_w(O)) / sqrt(mean_w(|O -
 // mean_w(O)|^2) + eps), window (2 radius + 1)^2, 0 where O = 0 (masked or dark pixels), eps =
-// relative_eps x the mean |O|^2 of the field's non-zero pixels. The
-// paper's cost -Re(O_ref* O_v) is a product of confidences, so bright, high-contrast regions of
-// a source view win whatever their alignment; normalised fields make the aggregated cost a
-// correlation of the orientation textures (a zero-mean NCC of the complex fields).
+// relative_eps x MeanSquareOfNonZero(orientation). The paper's cost -Re(O_ref* O_v) is a
+// product of confidences, so bright, high-contrast regions of a source view win whatever their
+// alignment; normalised fields make the aggregated cost a correlation of the orientation
+// textures (a zero-mean NCC of the complex fields).
 FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, float relative_eps);
+
+// The mean over the pixels where it is non-zero of the squared magnitude (summed over the
+// channels); 0 when every pixel is zero.
+double MeanSquareOfNonZero(const FloatMap& field);
 
 // `field` scaled so that the RMS magnitude of its non-zero pixels is `rms` (unchanged when all
 // are zero).
