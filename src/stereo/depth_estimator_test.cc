@@ -505,6 +505,17 @@ TEST(DepthEstimator, OrientationTransferIsNeededForARolledSource) {
 namespace hairmvs {
 namespace {
 
+// Three non-zero pixels of squared magnitude 25, 1 and 4 (both channels) among zeros: 10.
+TEST(MeanSquareOfNonZero, AveragesOnlyTheNonZeroPixels) {
+  FloatMap field(3, 2, 2, 0.0f);
+  field.At(0, 0, 0) = 3.0f;
+  field.At(0, 0, 1) = -4.0f;
+  field.At(1, 2, 1) = 1.0f;
+  field.At(1, 1, 0) = -2.0f;
+  EXPECT_DOUBLE_EQ(MeanSquareOfNonZero(field), 10.0);
+  EXPECT_EQ(MeanSquareOfNonZero(FloatMap(3, 2, 2, 0.0f)), 0.0);
+}
+
 // The guide's scaling: the non-zero pixels' RMS magnitude becomes the target, directions and
 // zeros stay; an all-zero field stays as it is.
 TEST(ScaleToRms, NonZeroPixelsGetTheTargetRms) {
