@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "src/core/timer.h"
+#include "src/mrf/mrf_solver_names.h"
 
 namespace hairmvs {
 
@@ -435,9 +436,7 @@ struct OrientationStereoOptions {
     v("lambda", &lambda, "smoothness weight per squared coarse label");
     v("truncation_labels", &truncation_labels,
       "truncate the quadratic smoothness at this label difference (<= 0: none)");
-    v("mrf_solver", &mrf_solver,
-      "MRF solver: graph_cuts | semi_global | semi_global_cpu | belief_propagation | "
-      "belief_propagation_cpu | icm | winner_take_all");
+    v("mrf_solver", &mrf_solver, kMrfSolverNameList);
     v("mrf_max_cycles", &mrf_max_cycles, "MRF solver cycles / iterations");
     v("mrf_icm_polish_iterations", &mrf_icm_polish_iterations,
       "ICM sweeps polishing the MRF solver's labels (0: none)");

@@ -20,9 +20,6 @@ struct OptionParser::Impl {
   std::vector<std::string> names;
   std::map<std::string, std::function<std::string()>> printers;
   std::map<std::string, std::function<bool(const std::string&)>> converters;
-  // The help text of each converted option: a bad value's error repeats it (for an enum it
-  // lists the accepted names).
-  std::map<std::string, std::string> converter_help;
   std::map<std::string, std::string> ignored;
 };
 
@@ -109,7 +106,6 @@ void OptionParser::AddConverted(const std::string& name, const std::string& defa
   impl_->names.push_back(name);
   impl_->printers[name] = std::move(print);
   impl_->converters[name] = std::move(parse);
-  impl_->converter_help[name] = help;
 }
 
 void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
@@ -134,9 +130,10 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
   for (auto& [name, parse] : impl_->converters) {
     if (!impl_->vm.count(name) || impl_->vm[name].defaulted()) continue;
     const std::string text = impl_->vm[name].as<std::string>();
+    // The option's help repeated: for an enum it lists the accepted names.
     THROW_IF(!parse(text), "hairmvs " << impl_->command << ": invalid value '" << text
                                       << "' for --" << name << " ("
-                                      << impl_->converter_help[name] << ")");
+                                      << impl_->desc.find(name, false).description() << ")");
   }
   for (const auto& [name, why] : impl_->ignored) {
     if (impl_->vm.count(name)) {

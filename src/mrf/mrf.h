@@ -27,6 +27,8 @@
 #include <string>
 #include <vector>
 
+#include "src/mrf/mrf_solver_names.h"
+
 namespace hairmvs {
 
 class OpenCLContext;
@@ -118,9 +120,7 @@ struct MrfSolverOptions {
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
-    v("solver", &solver,
-      "graph_cuts | semi_global | semi_global_cpu | belief_propagation | "
-      "belief_propagation_cpu | icm | winner_take_all");
+    v("solver", &solver, kMrfSolverNameList);
     v("max_cycles", &max_cycles, "alpha-expansion cycles (graph_cuts) or ICM sweeps (icm)");
     v("min_relative_decrease", &min_relative_decrease,
       "stop when a cycle lowers the energy by less than this fraction");

@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <random>
+#include <set>
+#include <string>
 
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
@@ -102,6 +104,15 @@ TEST(MrfProblem, ValidateNamesTheBadField) {
 }
 
 TEST(MrfSolverOptions, NamesRoundTripAndCheck) {
+  // The help texts' list (kMrfSolverNameList), split at " | ": exactly the solvers' names.
+  std::set<std::string> listed;
+  const std::string list = kMrfSolverNameList;
+  for (size_t begin = 0; begin <= list.size();) {
+    const size_t end = std::min(list.find(" | ", begin), list.size());
+    listed.insert(list.substr(begin, end - begin));
+    begin = end + 3;
+  }
+  std::set<std::string> names;
   for (MrfSolverType t : {MrfSolverType::kGraphCuts, MrfSolverType::kSemiGlobal,
                           MrfSolverType::kSemiGlobalCpu, MrfSolverType::kBeliefPropagation,
                           MrfSolverType::kBeliefPropagationCpu, MrfSolverType::kIcm,
@@ -109,7 +120,9 @@ TEST(MrfSolverOptions, NamesRoundTripAndCheck) {
     MrfSolverType parsed = MrfSolverType::kWinnerTakeAll;
     ASSERT_TRUE(FromString(ToString(t), &parsed)) << ToString(t);
     EXPECT_EQ(parsed, t);
+    names.insert(ToString(t));
   }
+  EXPECT_EQ(listed, names) << kMrfSolverNameList;
   MrfSolverType parsed;
   EXPECT_FALSE(FromString("graphcuts", &parsed));
   MrfSolverOptions options;
