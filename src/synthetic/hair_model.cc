@@ -42,6 +42,15 @@ Eigen::Vector3d AnyPerpendicular(const Eigen::Vector3d& t) {
   return (a - a.dot(t) * t).normalized();
 }
 
+// Dark brown with a per-strand variation in brightness and hue (linear RGB).
+Eigen::Vector3f DarkBrownAlbedo(SplitMix64* rng) {
+  const double brightness = std::clamp(1.0 + 0.25 * rng->Normal(), 0.5, 1.6);
+  const double warmth = rng->Uniform(-0.1, 0.1);
+  return Eigen::Vector3f(static_cast<float>(0.036 * brightness * (1 + warmth)),
+                         static_cast<float>(0.022 * brightness),
+                         static_cast<float>(0.015 * brightness * (1 - warmth)));
+}
+
 std::vector<Eigen::Vector3f> GrowStrand(const HeadModel& head, HairStyle style, uint64_t seed,
                                         int index, float* layer_out, Eigen::Vector3f* albedo) {
   SplitMix64 rng(DeriveSeed(seed, 1, static_cast<uint64_t>(index)));
@@ -127,12 +136,7 @@ std::vector<Eigen::Vector3f> GrowStrand(const HeadModel& head, HairStyle style, 
     }
   }
 
-  // Dark brown with a per-strand variation in brightness and hue (linear RGB).
-  const double brightness = std::clamp(1.0 + 0.25 * rng.Normal(), 0.5, 1.6);
-  const double warmth = rng.Uniform(-0.1, 0.1);
-  *albedo = Eigen::Vector3f(static_cast<float>(0.036 * brightness * (1 + warmth)),
-                            static_cast<float>(0.022 * brightness),
-                            static_cast<float>(0.015 * brightness * (1 - warmth)));
+  *albedo = DarkBrownAlbedo(&rng);
   *layer_out = static_cast<float>(layer);
   return points;
 }
@@ -217,6 +221,42 @@ HairStrands GenerateHair(const HeadModel& head, const HairGenerationOptions& opt
   for (int i = 0; i < n; ++i) hair.offsets[i + 1] = hair.offsets[i] + strands[i].size();
   hair.points.reserve(hair.offsets[n]);
   for (const auto& s : strands) hair.points.insert(hair.points.end(), s.begin(), s.end());
+  return hair;
+}
+
+HairStrands HairFromStrands(const HeadModel& head, std::vector<Eigen::Vector3f> points,
+                            std::vector<int64_t> offsets, uint64_t seed) {
+  THROW_IF(offsets.size() < 2 || offsets.front() != 0 ||
+               offsets.back() != static_cast<int64_t>(points.size()),
+           "HairFromStrands: the offsets must run from 0 to the number of points ("
+               << points.size() << ")");
+  HairStrands hair;
+  hair.points = std::move(points);
+  hair.offsets = std::move(offsets);
+  const int n = hair.NumStrands();
+  hair.layer.resize(n);
+  hair.albedo.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int64_t begin = hair.offsets[i], end = hair.offsets[i + 1];
+    THROW_IF(end - begin < 2, "HairFromStrands: strand " << i << " has " << end - begin
+                                                          << " point(s); a strand needs 2");
+    // Height above the ellipsoid along the ray from its centre: |p - c| (1 - 1 / sqrt(s)),
+    // s = ShellValue (1 on the surface).
+    std::vector<double> heights;
+    for (int64_t k = begin; k < end; ++k) {
+      const Eigen::Vector3d p = hair.points[k].cast<double>();
+      const double shell = head.ShellValue(p, 0.0);
+      heights.push_back(shell > 0 ? (p - head.centre).norm() * (1.0 - 1.0 / std::sqrt(shell))
+                                  : 0.0);
+    }
+    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+    const double height = heights[heights.size() / 2];
+    hair.layer[i] =
+        static_cast<float>(std::clamp((height - kMinLayerM) / kLayerSpanM, 0.0, 1.0));
+    // Stream 4: GenerateHair's strands use 1, the handheld rig 2, the sparse points 3.
+    SplitMix64 rng(DeriveSeed(seed, 4, static_cast<uint64_t>(i)));
+    hair.albedo[i] = DarkBrownAlbedo(&rng);
+  }
   return hair;
 }
 

@@ -59,6 +59,13 @@ struct HairGenerationOptions {
 // above the scalp so the hair is a volume. `curly` adds helical curls around that path.
 HairStrands GenerateHair(const HeadModel& head, const HairGenerationOptions& options);
 
+// Strands given from outside (a data set's gt/strands_*.npy, root first) made renderable: each
+// strand's layer from the median height of its points above the head's surface, on
+// GenerateHair's scale (a layer settles 1 + 14 * layer mm above the scalp; clamped to [0, 1]),
+// and a dark-brown albedo drawn as GenerateHair draws it, from its own stream of `seed`.
+HairStrands HairFromStrands(const HeadModel& head, std::vector<Eigen::Vector3f> points,
+                            std::vector<int64_t> offsets, uint64_t seed);
+
 // Strands resampled along their uniform Catmull-Rom splines (end points repeated, as the
 // evaluation's StrandDistance and Blender do: p_{-1} = p_0), every stored point kept, at most `max_spacing_m` apart; with the
 // tube radius of each point (linear in the stored index from root to tip).

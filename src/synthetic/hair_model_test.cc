@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "src/core/logging.h"
 #include "src/evaluation/ground_truth.h"
 
 namespace hairmvs {
@@ -63,6 +64,41 @@ TEST(GenerateHair, RootsOnScalpPointsOutsideHeadDeterministic) {
     const HairStrands other = SmallHair(style, 8);
     EXPECT_NE(other.points, hair.points);
   }
+}
+
+// Given strands: layers from their height above the scalp on GenerateHair's scale (1 + 14 *
+// layer mm), dark-brown albedos from the seed; offsets that do not cover the points throw.
+TEST(HairFromStrands, LayersFromHeightAboveScalpAndSeededAlbedo) {
+  const HeadModel head;  // the top of the head at z = 0.11
+  std::vector<Eigen::Vector3f> points;
+  std::vector<int64_t> offsets = {0};
+  for (double height : {0.0, 0.008, 0.030}) {
+    for (int k = 0; k < 5; ++k) {  // a short strand at that height over the crown
+      points.emplace_back(0.001f * k, 0.0f, static_cast<float>(0.11 + height));
+    }
+    offsets.push_back(static_cast<int64_t>(points.size()));
+  }
+  const HairStrands hair = HairFromStrands(head, points, offsets, 3);
+  ASSERT_EQ(hair.NumStrands(), 3);
+  EXPECT_EQ(hair.points, points);
+  EXPECT_EQ(hair.offsets, offsets);
+  EXPECT_FLOAT_EQ(hair.layer[0], 0.0f);  // on the scalp: below the lowest layer, clamped
+  EXPECT_NEAR(hair.layer[1], 0.5, 0.01);  // (8 - 1) / 14
+  EXPECT_FLOAT_EQ(hair.layer[2], 1.0f);  // 30 mm up: above the outermost layer, clamped
+  for (const Eigen::Vector3f& albedo : hair.albedo) {
+    EXPECT_GT(albedo.x(), albedo.y());
+    EXPECT_GT(albedo.y(), albedo.z());
+    EXPECT_LT(albedo.x(), 0.07f);
+    EXPECT_GT(albedo.z(), 0.005f);
+  }
+  EXPECT_NE(hair.albedo[0], hair.albedo[1]);
+  EXPECT_EQ(HairFromStrands(head, points, offsets, 3).albedo, hair.albedo);
+  EXPECT_NE(HairFromStrands(head, points, offsets, 4).albedo, hair.albedo);
+
+  const std::vector<int64_t> short_of_the_points = {0, 5, 10};  // 15 points
+  EXPECT_THROW(HairFromStrands(head, points, short_of_the_points, 3), Error);
+  const std::vector<int64_t> one_point_strand = {0, 1, 10, 15};
+  EXPECT_THROW(HairFromStrands(head, points, one_point_strand, 3), Error);
 }
 
 // Curls make a strand much longer than the distance it covers.

@@ -154,7 +154,16 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   hair_options.style = options.style;
   hair_options.num_strands = options.num_strands;
   hair_options.seed = static_cast<uint64_t>(options.seed);
-  HairStrands hair = GenerateHair(head, hair_options);
+  HairStrands hair;
+  if (options.strands_path.empty()) {
+    hair = GenerateHair(head, hair_options);
+  } else {
+    GroundTruthStrands given = ReadGroundTruthStrands(options.strands_path);
+    THROW_IF(given.NumStrands() == 0,
+             "synthesize: no strands in " << options.strands_path << " (strands_offsets.npy)");
+    hair = HairFromStrands(head, std::move(given.points), std::move(given.offsets),
+                           static_cast<uint64_t>(options.seed));
+  }
   const Eigen::Vector3d hair_centre = hair.BoundingBoxCentre();
   DenseStrands dense = DensifyStrands(
       hair,
@@ -281,6 +290,7 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   meta["head_supersampling"] = options.head_supersampling;
   meta["hair_centre"] = {hair_centre.x(), hair_centre.y(), hair_centre.z()};
   meta["n_strands"] = result.num_strands;
+  if (!options.strands_path.empty()) meta["strands_path"] = options.strands_path;
   meta["n_points"] = result.num_strand_points;
   meta["hair_root_diameter_m"] = options.hair_root_diameter_m;
   meta["hair_tip_diameter_m"] = options.hair_tip_diameter_m;

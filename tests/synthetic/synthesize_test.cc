@@ -149,6 +149,50 @@ TEST(Synthesize, GantryWorkspaceReadsBackWithGroundTruth) {
 
 // Same seed, same bytes (the .npz archives' zip headers carry libzip's time stamps, so their
 // arrays are compared); another seed, other images.
+// Rendering a set's own strands (--strands_path its gt/) gives the same geometry: the same
+// strands in gt/, the same cameras and true depths and labels; only the strands' colours
+// differ (they are not stored).
+TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
+  const std::string first_path = TempDir("strands_first");
+  RunSynthesize(SmallOptions(first_path));
+  const std::string gt_first = JoinPaths(first_path, "gt");
+  const std::string second_path = TempDir("strands_second");
+  SynthesizeOptions options = SmallOptions(second_path);
+  options.strands_path = gt_first;
+  options.num_strands = 7;  // not used with strands_path
+  const SynthesizeResult result = RunSynthesize(options);
+  EXPECT_EQ(result.num_strands, 1500);
+  const std::string gt_second = JoinPaths(second_path, "gt");
+  const GroundTruthStrands a = ReadGroundTruthStrands(gt_first);
+  const GroundTruthStrands b = ReadGroundTruthStrands(gt_second);
+  EXPECT_EQ(a.points, b.points);
+  EXPECT_EQ(a.offsets, b.offsets);
+  const GroundTruthCameras cameras = ReadGroundTruthCameras(gt_second);
+  const GroundTruthCameras cameras_first = ReadGroundTruthCameras(gt_first);
+  ASSERT_EQ(cameras.names, cameras_first.names);
+  ASSERT_EQ(cameras.names.size(), 4u);
+  for (size_t i = 0; i < cameras.names.size(); ++i) {
+    EXPECT_EQ(cameras.R[i], cameras_first.R[i]);
+    EXPECT_EQ(cameras.t[i], cameras_first.t[i]);
+  }
+  for (const std::string& name : cameras.names) {
+    const GroundTruthView va = ReadGroundTruthView(gt_first, name);
+    const GroundTruthView vb = ReadGroundTruthView(gt_second, name);
+    EXPECT_EQ(va.depth.Data(), vb.depth.Data()) << name;
+    EXPECT_EQ(va.label, vb.label) << name;
+  }
+  EXPECT_NE(ReadBytes(JoinPaths(first_path, "dense", "images", "g0_c.png")),
+            ReadBytes(JoinPaths(second_path, "dense", "images", "g0_c.png")));
+
+  options.strands_path = JoinPaths(first_path, "no_such_folder");
+  try {
+    RunSynthesize(options);
+    ADD_FAILURE() << "no error for a missing strands folder";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("strands_points.npy"), std::string::npos) << e.what();
+  }
+}
+
 TEST(Synthesize, DeterministicForASeed) {
   const std::string a = TempDir("det_a"), b = TempDir("det_b"), c = TempDir("det_c");
   SynthesizeOptions options = SmallOptions(a);
