@@ -220,6 +220,9 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
       "No " + options.depth_type + " depth maps in " + JoinPaths(ws.StereoPath(), "depth_maps"));
   const std::string output_path = EvaluationFolder(ws, options.output_path);
 
+  const GroundTruthCameras true_cameras =
+      options.in_true_cameras ? ReadGroundTruthCameras(ground_truth_path) : GroundTruthCameras();
+
   DepthEvaluationResult result;
   DepthSamples pooled;
   std::mt19937 rng(options.seed);
@@ -242,6 +245,19 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const Image& image = ws.ImageByName(name);
     const Eigen::Matrix3d R = image.R();
     const Eigen::Vector3d t = image.t();
+    // The view's true camera, for in_true_cameras; K is at the true maps' size.
+    int true_camera = -1;
+    if (options.in_true_cameras) {
+      true_camera = true_cameras.Find(name);
+      THROW_IF(true_camera < 0, JoinPaths(ground_truth_path, "cameras.npz")
+                                    << ": no camera named " << name
+                                    << " (or evaluate with --in_true_cameras 0)");
+      THROW_IF(true_cameras.width != gt_width || true_cameras.height != gt_height,
+               JoinPaths(ground_truth_path, "cameras.npz")
+                   << ": cameras of " << true_cameras.width << " x " << true_cameras.height
+                   << " px, but " << GroundTruthViewPath(ground_truth_path, name) << " is "
+                   << gt_width << " x " << gt_height);
+    }
 
     // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in
     // depth-map pixels scaled to gt pixels.
@@ -268,11 +284,30 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     cv::Mat signed_levels(height, width, CV_32FC1, cv::Scalar(0));
     cv::Mat has_depth(height, width, CV_8UC1, cv::Scalar(0));
     for (int r = 0; r < height; ++r) {
-      const int gr = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
+      const int same_row = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
       for (int c = 0; c < width; ++c) {
-        const int gc = std::min(gt_width - 1, (2 * c + 1) * gt_width / (2 * width));
-        const uint8_t label = gt.label[static_cast<size_t>(gr) * gt_width + gc];
+        int gr = same_row;
+        int gc = std::min(gt_width - 1, (2 * c + 1) * gt_width / (2 * width));
         const float d = depth.At(r, c);
+        // The depth compared: the map's own, or the point's z in the true camera.
+        Eigen::Vector3d world = Eigen::Vector3d::Zero();
+        double compared_depth = d;
+        if (d > 0) {
+          world = R.transpose() * (BackProjectPixel(K, c, r, d) - t);
+          if (true_camera >= 0) {
+            const Eigen::Vector3d x = true_cameras.K * (true_cameras.R[true_camera] * world +
+                                                        true_cameras.t[true_camera]);
+            const double col = std::floor(x.x() / x.z()), row = std::floor(x.y() / x.z());
+            // A depth that lands outside the true image (or behind it) has no truth to meet.
+            if (!(x.z() > 0) || col < 0 || row < 0 || col >= gt_width || row >= gt_height) {
+              continue;
+            }
+            gc = static_cast<int>(col);
+            gr = static_cast<int>(row);
+            compared_depth = x.z();
+          }
+        }
+        const uint8_t label = gt.label[static_cast<size_t>(gr) * gt_width + gc];
         cv::Vec3b& pixel = error_image.at<cv::Vec3b>(r, c);
         if (label != kLabelHair) {
           if (label == kLabelSkin) pixel = cv::Vec3b(40, 40, 40);
@@ -284,13 +319,14 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
           pixel = cv::Vec3b(160, 160, 160);  // missing: grey
           continue;
         }
-        const double signed_error = static_cast<double>(d) - gt.depth.At(gr, gc);
+        const double signed_error = compared_depth - gt.depth.At(gr, gc);
         const bool near_silhouette =
             distance_to_background.at<float>(gr, gc) <= silhouette_band_gt_px;
         (near_silhouette ? samples.silhouette_errors_m : samples.interior_errors_m)
             .push_back(signed_error);
         if (options.layer_window_px > 0) {
-          const double layer = LayerInWindow(gt, gr, gc, options.layer_window_px, d);
+          const double layer =
+              LayerInWindow(gt, gr, gc, options.layer_window_px, compared_depth);
           if (layer >= 0) samples.layers.push_back(layer);
         }
         const double abs_error = std::abs(signed_error);
@@ -299,7 +335,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         signed_levels.at<float>(r, c) = static_cast<float>(
             std::clamp(1e3 * signed_error / options.error_image_max_mm, -1.0, 1.0));
         has_depth.at<uint8_t>(r, c) = 255;
-        points.push_back(R.transpose() * (BackProjectPixel(K, c, r, d) - t));
+        points.push_back(world);
       }
     }
     if (options.max_points_3d_per_view > 0 &&
@@ -343,6 +379,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   json["ground_truth_path"] = ground_truth_path;
   json["depth_type"] = options.depth_type;
   json["pixel_convention"] = "SfM: pixel (col, row) centred at (col + 0.5, row + 0.5)";
+  json["in_true_cameras"] = options.in_true_cameras;
   json["max_points_3d_per_view"] = options.max_points_3d_per_view;
   json["strand_spacing_m"] = options.strand_spacing_m;
   json["overall"] = ToJson(result.overall);
