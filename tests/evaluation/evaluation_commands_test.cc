@@ -273,24 +273,40 @@ TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
 }
 
 // A workspace whose v1 is off its true pose, as a mapper's poses are: 5 mm nearer the hair
-// along its axis and turned 0.4 degrees (2.8 px here). Its own exact depths, compared at the
-// true pixel of the same index, are 5 mm off; compared in the true camera, they meet the truth.
+// along its axis and turned 0.4 degrees (2.8 px here). import_ground_truth gives the true maps
+// their true poses back. The off-pose camera's own exact depths, compared at the true pixel of
+// the same index, are 5 mm off; compared in the true camera, they meet the truth.
 TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   const Scene scene = MakeScene("off_pose");
-  const std::string out = JoinPaths(scene.dir, "off_pose");
-  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
-  Reconstruction model = ReadReconstruction(JoinPaths(out, "sparse"));
+  const std::string sparse = JoinPaths(scene.workspace, "sparse");
+  Reconstruction model = ReadReconstruction(sparse);
   Image* v1 = nullptr;
   for (auto& [id, image] : model.images) {
     if (image.name == "v1.png") v1 = &image;
   }
   ASSERT_NE(v1, nullptr);
-  const Eigen::Vector3d centre = v1->ProjectionCenter() + 5e-3 * v1->ViewingDirection();
+  const Eigen::Vector3d true_centre = v1->ProjectionCenter();
+  const Eigen::Vector3d centre = true_centre + 5e-3 * v1->ViewingDirection();
   const Eigen::Matrix3d R =
       Eigen::AngleAxisd(0.4 * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix() * v1->R();
   const Eigen::Vector3d t = -R * centre;
   v1->cam_from_world_rotation = Eigen::Quaterniond(R);
   v1->cam_from_world_translation = t;
+  WriteReconstruction(model, sparse, ModelFormat::kText);
+
+  const std::string out = JoinPaths(scene.dir, "off_pose");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  const Reconstruction imported = ReadReconstruction(JoinPaths(out, "sparse"));
+  for (const auto& [id, image] : imported.images) {
+    if (image.name == "v1.png") EXPECT_LT((image.ProjectionCenter() - true_centre).norm(), 1e-12);
+  }
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v1.png"};
+  for (bool in_true_cameras : {true, false}) {
+    options.in_true_cameras = in_true_cameras;
+    EXPECT_LT(EvaluateDepthMaps(out, scene.gt, options).overall.mean_abs_error_mm, 1e-3);
+  }
+
   WriteReconstruction(model, JoinPaths(out, "sparse"), ModelFormat::kText);
   FloatMap depth(kWidth, kHeight, 1, 0.0f);
   for (int r = 0; r < kHeight; ++r) {
@@ -302,9 +318,7 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
     }
   }
   WriteMat(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"), depth);
-
-  DepthEvaluationOptions options = FastDepthOptions();
-  options.image_names = {"v1.png"};
+  options.in_true_cameras = true;
   const DepthMetrics in_true = EvaluateDepthMaps(out, scene.gt, options).overall;
   // The truth is sampled at the centre of the true pixel a point lands in: within half a
   // pixel (0.6 mm on the plane, which v1 sees 3.4 degrees off fronto-parallel: 0.04 mm).
