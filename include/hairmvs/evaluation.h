@@ -185,6 +185,10 @@ struct DataTermEvaluationOptions {
   double min_hair_fraction = 0.5;
   // The JSON goes here; empty = <workspace>/stereo/evaluation.
   std::string output_path;
+  // As DepthEvaluationOptions::in_true_cameras: each true hair depth, back-projected with the
+  // true camera, counts in the coarse pixel of the workspace's camera it lands in, as a z-depth
+  // there (1), or in the coarse pixel that holds its own pixel's centre (0).
+  bool in_true_cameras = true;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -192,6 +196,9 @@ struct DataTermEvaluationOptions {
     v("min_hair_fraction", &min_hair_fraction,
       "count a coarse pixel when at least this fraction of its image pixels are hair");
     v("output_path", &output_path, "folder for the JSON (default W/stereo/evaluation)");
+    v("in_true_cameras", &in_true_cameras,
+      "carry the true depths from the true cameras into the workspace's (1) or take them at "
+      "the same pixels (0)");
   }
   bool Check(std::string* error) const;
 };

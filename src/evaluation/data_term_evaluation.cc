@@ -100,33 +100,40 @@ int FirstFinePixel(int coarse, int fine_size, int coarse_size) {
   return static_cast<int>(std::ceil(static_cast<double>(coarse) * fine_size / coarse_size - 0.5));
 }
 
-// The samples of one view: its volume against the true depths.
-void EvaluateView(const CostVolume& volume, const GroundTruthView& gt, double min_hair_fraction,
-                  DataTermSamples* samples) {
+// The samples of one view: its volume against the true depths. Each true hair depth is
+// back-projected with `truth_camera` (the camera the truth was rendered with, or the
+// workspace's at the truth's size) and lands, as a z-depth in the workspace's camera of the
+// volume's grid, in one coarse pixel: the true depths of a coarse pixel are those of the image
+// pixels whose centres fall in it where the two cameras are the same.
+void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
+                  const GridCamera& truth_camera, const GridCamera& grid_camera,
+                  double min_hair_fraction, DataTermSamples* samples) {
   const FloatMap& cost = volume.cost;
   const std::vector<double>& depths = volume.label_depths;
   const int cw = cost.Width(), ch = cost.Height(), num_labels = cost.Channels();
   const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
-  std::vector<double> hair_depths;
+  std::vector<std::vector<double>> cell_depths(static_cast<size_t>(cw) * ch);
+  for (int gr = 0; gr < gt_height; ++gr) {
+    for (int gc = 0; gc < gt_width; ++gc) {
+      const float d = gt.depth.At(gr, gc);
+      if (gt.label[static_cast<size_t>(gr) * gt_width + gc] != kLabelHair || !(d > 0)) continue;
+      int c, r;
+      double z;
+      if (grid_camera.Project(truth_camera.BackProject(gc, gr, d), &c, &r, &z)) {
+        cell_depths[static_cast<size_t>(r) * cw + c].push_back(z);
+      }
+    }
+  }
   std::vector<float> costs(num_labels);
   for (int r = 0; r < ch; ++r) {
     // The image pixels whose centres fall into coarse pixel (r, c).
-    const int row_begin = FirstFinePixel(r, gt_height, ch);
-    const int row_end = FirstFinePixel(r + 1, gt_height, ch);
+    const int row_begin = std::max(0, FirstFinePixel(r, gt_height, ch));
+    const int row_end = std::min(gt_height, FirstFinePixel(r + 1, gt_height, ch));
     for (int c = 0; c < cw; ++c) {
-      const int col_begin = FirstFinePixel(c, gt_width, cw);
-      const int col_end = FirstFinePixel(c + 1, gt_width, cw);
-      hair_depths.clear();
-      int covered = 0;
-      for (int gr = std::max(0, row_begin); gr < std::min(gt_height, row_end); ++gr) {
-        for (int gc = std::max(0, col_begin); gc < std::min(gt_width, col_end); ++gc) {
-          ++covered;
-          const float d = gt.depth.At(gr, gc);
-          if (gt.label[static_cast<size_t>(gr) * gt_width + gc] == kLabelHair && d > 0) {
-            hair_depths.push_back(d);
-          }
-        }
-      }
+      const int col_begin = std::max(0, FirstFinePixel(c, gt_width, cw));
+      const int col_end = std::min(gt_width, FirstFinePixel(c + 1, gt_width, cw));
+      const int covered = std::max(0, row_end - row_begin) * std::max(0, col_end - col_begin);
+      const std::vector<double>& hair_depths = cell_depths[static_cast<size_t>(r) * cw + c];
       if (covered == 0 || hair_depths.empty() ||
           hair_depths.size() < min_hair_fraction * covered) {
         continue;
@@ -180,6 +187,9 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
       ws, options.image_names, [&](const std::string& name) { return ws.CostVolumePath(name); },
       "No cost volumes in " + JoinPaths(ws.StereoPath(), "cost_volumes") +
           " (run orientation_stereo with --OrientationStereo.write_cost_volume 1)");
+  const GroundTruthCameras true_cameras =
+      options.in_true_cameras ? ReadGroundTruthCameras(ground_truth_path) : GroundTruthCameras();
+
   DataTermEvaluationResult result;
   DataTermSamples pooled;
   Progress progress("evaluate_data_term", static_cast<int>(names.size()));
@@ -191,7 +201,14 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
     THROW_IF(volume.cost.Channels() < 2,
              ws.CostVolumePath(name) << ": a cost volume needs at least 2 labels");
     DataTermSamples samples;
-    EvaluateView(volume, ReadGroundTruthView(ground_truth_path, name),
+    const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
+    const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
+    const GridCamera truth_camera =
+        options.in_true_cameras
+            ? TrueGridCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
+            : WorkspaceGridCamera(ws, name, gt_width, gt_height);
+    EvaluateView(volume, gt, truth_camera,
+                 WorkspaceGridCamera(ws, name, volume.cost.Width(), volume.cost.Height()),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);
@@ -203,6 +220,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
   json["workspace_path"] = workspace_path;
   json["ground_truth_path"] = ground_truth_path;
   json["min_hair_fraction"] = options.min_hair_fraction;
+  json["in_true_cameras"] = options.in_true_cameras;
   json["overall"] = ToJson(result.overall);
   json["views"] = nlohmann::json::array();
   for (const DataTermMetrics& m : result.views) json["views"].push_back(ToJson(m));

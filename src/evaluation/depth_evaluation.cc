@@ -10,13 +10,13 @@
 #include <cmath>
 #include <cstdio>
 #include <iomanip>
+#include <optional>
 #include <random>
 #include <utility>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
-#include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
@@ -236,27 +236,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
     const int width = depth.Width(), height = depth.Height();
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
-    // The workspace camera, scaled to the depth map (SfM convention: the image edges map to
-    // the image edges, so pixel-centre coordinates scale by the size ratio).
-    const Camera& camera = ws.CameraOf(name);
-    Eigen::Matrix3d K = camera.CalibrationMatrix();
-    K.row(0) *= static_cast<double>(width) / camera.width;
-    K.row(1) *= static_cast<double>(height) / camera.height;
-    const Image& image = ws.ImageByName(name);
-    const Eigen::Matrix3d R = image.R();
-    const Eigen::Vector3d t = image.t();
-    // The view's true camera, for in_true_cameras; K is at the true maps' size.
-    int true_camera = -1;
+    const GridCamera camera = WorkspaceGridCamera(ws, name, width, height);
+    std::optional<GridCamera> true_camera;
     if (options.in_true_cameras) {
-      true_camera = true_cameras.Find(name);
-      THROW_IF(true_camera < 0, JoinPaths(ground_truth_path, "cameras.npz")
-                                    << ": no camera named " << name
-                                    << " (or evaluate with --in_true_cameras 0)");
-      THROW_IF(true_cameras.width != gt_width || true_cameras.height != gt_height,
-               JoinPaths(ground_truth_path, "cameras.npz")
-                   << ": cameras of " << true_cameras.width << " x " << true_cameras.height
-                   << " px, but " << GroundTruthViewPath(ground_truth_path, name) << " is "
-                   << gt_width << " x " << gt_height);
+      true_camera = TrueGridCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);
     }
 
     // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in
@@ -293,19 +276,9 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         Eigen::Vector3d world = Eigen::Vector3d::Zero();
         double compared_depth = d;
         if (d > 0) {
-          world = R.transpose() * (BackProjectPixel(K, c, r, d) - t);
-          if (true_camera >= 0) {
-            const Eigen::Vector3d x = true_cameras.K * (true_cameras.R[true_camera] * world +
-                                                        true_cameras.t[true_camera]);
-            const double col = std::floor(x.x() / x.z()), row = std::floor(x.y() / x.z());
-            // A depth that lands outside the true image (or behind it) has no truth to meet.
-            if (!(x.z() > 0) || col < 0 || row < 0 || col >= gt_width || row >= gt_height) {
-              continue;
-            }
-            gc = static_cast<int>(col);
-            gr = static_cast<int>(row);
-            compared_depth = x.z();
-          }
+          world = camera.BackProject(c, r, d);
+          // A depth that lands outside the true image (or behind it) has no truth to meet.
+          if (true_camera && !true_camera->Project(world, &gc, &gr, &compared_depth)) continue;
         }
         const uint8_t label = gt.label[static_cast<size_t>(gr) * gt_width + gc];
         cv::Vec3b& pixel = error_image.at<cv::Vec3b>(r, c);

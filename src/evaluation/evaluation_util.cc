@@ -4,6 +4,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 
@@ -97,6 +98,55 @@ std::string EvaluationFolder(const Workspace& ws, const std::string& output_path
 void WriteJsonSummary(const std::string& path, const nlohmann::json& json) {
   const std::string text = json.dump(1);
   WriteFileAtomically(path, [&text](std::ostream& out) { out << text << "\n"; }, false);
+}
+
+Eigen::Vector3d GridCamera::BackProject(int col, int row, double depth) const {
+  return R.transpose() * (BackProjectPixel(K, col, row, depth) - t);
+}
+
+bool GridCamera::Project(const Eigen::Vector3d& world, int* col, int* row, double* depth) const {
+  const Eigen::Vector3d x = K * (R * world + t);
+  if (!(x.z() > 0)) return false;
+  const double c = std::floor(x.x() / x.z()), r = std::floor(x.y() / x.z());
+  if (!(c >= 0 && r >= 0 && c < width && r < height)) return false;
+  *col = static_cast<int>(c);
+  *row = static_cast<int>(r);
+  *depth = x.z();
+  return true;
+}
+
+GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int width,
+                               int height) {
+  const Camera& camera = ws.CameraOf(name);
+  const Image& image = ws.ImageByName(name);
+  GridCamera grid;
+  // SfM convention: the image edges map to the grid's edges, so pixel-centre coordinates
+  // scale by the size ratio.
+  grid.K = camera.CalibrationMatrix();
+  grid.K.row(0) *= static_cast<double>(width) / camera.width;
+  grid.K.row(1) *= static_cast<double>(height) / camera.height;
+  grid.R = image.R();
+  grid.t = image.t();
+  grid.width = width;
+  grid.height = height;
+  return grid;
+}
+
+GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
+                          const std::string& name, int width, int height) {
+  const std::string path = JoinPaths(gt_path, "cameras.npz");
+  const int i = cameras.Find(name);
+  THROW_IF(i < 0, path << ": no camera named " << name << " (or evaluate with --in_true_cameras 0)");
+  THROW_IF(cameras.width != width || cameras.height != height,
+           path << ": cameras of " << cameras.width << " x " << cameras.height << " px, but "
+                << GroundTruthViewPath(gt_path, name) << " is " << width << " x " << height);
+  GridCamera grid;
+  grid.K = cameras.K;
+  grid.R = cameras.R[i];
+  grid.t = cameras.t[i];
+  grid.width = width;
+  grid.height = height;
+  return grid;
 }
 
 }  // namespace hairmvs

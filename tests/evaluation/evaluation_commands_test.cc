@@ -333,6 +333,38 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   // edge that land on the background in one of the two.
   EXPECT_NEAR(same_index.accuracy_3d_mean_mm, in_true.accuracy_3d_mean_mm, 1e-3);
 
+  // The data term of the off-pose camera, cheapest at its own exact depth at each coarse pixel
+  // (4 x 4 image pixels, labels 1 mm apart): in the true camera its true depths are carried
+  // into the off-pose one and meet that label; at the same pixels they lie 5 mm behind.
+  CostVolume volume;
+  volume.cost = FloatMap(kWidth / 4, kHeight / 4, 80);
+  for (int k = 0; k < 80; ++k) volume.label_depths.push_back(0.44 + 1e-3 * k);
+  Eigen::Matrix3d K_coarse = scene.cameras.K;
+  K_coarse.topRows(2) *= 0.25;
+  for (int r = 0; r < kHeight / 4; ++r) {
+    for (int c = 0; c < kWidth / 4; ++c) {
+      const Eigen::Vector3d ray = R.transpose() * BackProjectPixel(K_coarse, c, r, 1.0);
+      const double z = (R * (centre + ray * ((kPlaneZ - centre.z()) / ray.z())) + t).z();
+      const double cheapest = (z - 0.44) / 1e-3;
+      for (int k = 0; k < 80; ++k) volume.cost.At(r, c, k) = std::abs(k - cheapest);
+    }
+  }
+  const std::string volumes = JoinPaths(out, "stereo", "cost_volumes");
+  WriteCostVolume(JoinPaths(volumes, "v1.png.coarse.bin"),
+                  JoinPaths(volumes, "v1.png.coarse.depths.txt"), volume);
+  DataTermEvaluationOptions data_term_options;
+  data_term_options.image_names = {"v1.png"};
+  const DataTermMetrics data_term_in_true =
+      EvaluateDataTerm(out, scene.gt, data_term_options).overall;
+  data_term_options.in_true_cameras = false;
+  const DataTermMetrics data_term_same =
+      EvaluateDataTerm(out, scene.gt, data_term_options).overall;
+  EXPECT_GT(data_term_in_true.num_pixels, 80);
+  // The cheapest label rounds the exact depth at the coarse pixel's centre to 1 mm; the true
+  // depths of its image pixels spread 0.2 mm about it.
+  EXPECT_LT(data_term_in_true.median_abs_error_mm, 0.6);
+  EXPECT_NEAR(data_term_same.median_abs_error_mm, 5.0, 0.6);
+
   // A true camera missing from gt/cameras.npz is named.
   GroundTruthCameras only_v0 = scene.cameras;
   only_v0.names.pop_back();
@@ -434,6 +466,14 @@ TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
   ASSERT_GT(half_hair, 50);
 
   WriteShiftedVolume(scene, 10);
+  // The workspace's cameras are the true ones: the true depths in the true cameras are those
+  // at the same pixels.
+  DataTermEvaluationOptions same_pixels;
+  same_pixels.in_true_cameras = false;
+  const DataTermMetrics at_truth_same_pixels =
+      EvaluateDataTerm(scene.workspace, scene.gt, same_pixels).overall;
+  EXPECT_EQ(at_truth_same_pixels.num_pixels, half_hair);
+  EXPECT_NEAR(at_truth_same_pixels.median_abs_error_mm, 0.0, 1e-6);
   const DataTermEvaluationResult at_truth =
       EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions());
   ASSERT_EQ(at_truth.views.size(), 1u);
