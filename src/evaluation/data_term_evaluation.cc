@@ -188,7 +188,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
       "No cost volumes in " + JoinPaths(ws.StereoPath(), "cost_volumes") +
           " (run orientation_stereo with --OrientationStereo.write_cost_volume 1)");
   const GroundTruthCameras true_cameras =
-      options.in_true_cameras ? ReadGroundTruthCameras(ground_truth_path) : GroundTruthCameras();
+      ReadTrueCameras(ground_truth_path, options.in_true_cameras);
 
   DataTermEvaluationResult result;
   DataTermSamples pooled;

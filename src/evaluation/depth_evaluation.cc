@@ -221,7 +221,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   const std::string output_path = EvaluationFolder(ws, options.output_path);
 
   const GroundTruthCameras true_cameras =
-      options.in_true_cameras ? ReadGroundTruthCameras(ground_truth_path) : GroundTruthCameras();
+      ReadTrueCameras(ground_truth_path, options.in_true_cameras);
 
   DepthEvaluationResult result;
   DepthSamples pooled;

@@ -132,6 +132,15 @@ GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int
   return grid;
 }
 
+GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras) {
+  if (!in_true_cameras) return GroundTruthCameras();
+  const std::string path = JoinPaths(gt_path, "cameras.npz");
+  THROW_IF(!ExistsFile(path), "Missing " << path
+                                         << ": the true cameras, in which each depth is compared "
+                                            "with the truth (or evaluate with --in_true_cameras 0)");
+  return ReadGroundTruthCameras(gt_path);
+}
+
 GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
                           const std::string& name, int width, int height) {
   const std::string path = JoinPaths(gt_path, "cameras.npz");

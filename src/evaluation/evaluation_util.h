@@ -71,6 +71,9 @@ struct GridCamera {
 // The workspace's camera of image `name`, scaled to a width x height grid.
 GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int width,
                                int height);
+// gt_path/cameras.npz when `in_true_cameras` (empty cameras otherwise). Throws hairmvs::Error
+// naming the file, and the way to compare at the same pixels instead, when it is missing.
+GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras);
 // The camera `name` was rendered with (gt_path/cameras.npz, read into `cameras`), on the true
 // maps' grid of width x height. Throws hairmvs::Error naming the file when the camera is
 // absent or of another size.

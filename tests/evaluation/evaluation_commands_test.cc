@@ -380,6 +380,19 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
               std::string::npos)
         << e.what();
   }
+  // No cameras.npz at all: named, with the way to compare at the same pixels.
+  std::filesystem::remove(JoinPaths(scene.gt, "cameras.npz"));
+  try {
+    EvaluateDepthMaps(out, scene.gt, options);
+    ADD_FAILURE() << "no error for a missing cameras.npz";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("Missing " + JoinPaths(scene.gt, "cameras.npz")),
+              std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("--in_true_cameras 0"), std::string::npos) << e.what();
+  }
+  options.in_true_cameras = false;
+  EXPECT_NO_THROW(EvaluateDepthMaps(out, scene.gt, options));
 }
 
 TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
