@@ -135,9 +135,9 @@ GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int
 GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras) {
   if (!in_true_cameras) return GroundTruthCameras();
   const std::string path = JoinPaths(gt_path, "cameras.npz");
-  THROW_IF(!ExistsFile(path), "Missing " << path
-                                         << ": the true cameras, in which each depth is compared "
-                                            "with the truth (or evaluate with --in_true_cameras 0)");
+  THROW_IF(!ExistsFile(path),
+           "Missing " << path << ": the true cameras, in which each depth is compared with the "
+                      << "truth (or evaluate with --in_true_cameras 0)");
   return ReadGroundTruthCameras(gt_path);
 }
 
