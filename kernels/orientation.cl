@@ -22,7 +22,8 @@
 //   mask           width x height at row stride out_stride; > 0 = valid.
 //   out            2 planes (Re O, Im O) of out_stride x height floats each.
 //   num_blocks, num_orientations, width, height, out_stride, gamma,
-//   min_positive_ratio   O = 0 unless max signed response > min_positive_ratio * max |response|.
+//   min_positive_ratio   O = 0 unless max signed response > min_positive_ratio * max |response|
+//                        (-1: dark strands too, every pixel with a response).
 // Theta_k = k pi / num_orientations (from +x towards +y); angles k >= num_orientations of the
 // last block carry zero weights and are never chosen.
 
@@ -75,8 +76,9 @@ __kernel void orientation_field(__global const float* restrict padded, int padde
     }
   }
 
-  // O = F exp(2 i Theta), F = max|response|^gamma, only for bright strands (Eq. 1: max signed
-  // response > 0, with a relative tolerance for responses that are zero up to rounding).
+  // O = F exp(2 i Theta), F = max|response|^gamma, for bright strands only (Eq. 1: max signed
+  // response > 0, with a relative tolerance for responses that are zero up to rounding) or, with
+  // a ratio of -1, for dark ones too.
   const floatV confidence = pow(fmax(best_abs, (floatV)(0.0f)), (floatV)(gamma));
   const floatV two_theta = best_index * (2.0f * M_PI_F / (float)num_orientations);
   floatV cos_two_theta;

@@ -56,6 +56,22 @@ struct OrientationFieldOptions {
   // and sampling-level sign (measured: 1e-5 of the strand's |response|), which would let a
   // dark strand through at random; 1e-4 treats such responses as zero. 0 = the paper's test.
   double min_positive_response_ratio = 1e-4;
+  // Dark strands make the field too: O from the largest |response| whatever its sign, where the
+  // paper (Eq. 1) keeps only bright strands (false: O = 0 unless the largest signed response
+  // passes the test above). Dark hair seen against something brighter (the skin through a thin
+  // fringe, lit strands further in) is a dark ridge: the paper's rule drops it and keeps the
+  // bright gaps beside it, which run at the strands' angle but lie at the depth of what is
+  // seen through them. Measured (orientation_stereo, .geometric maps; complete / per-pixel
+  // mean / median / 3D mean / 3D median, mm; paper's rule -> dark strands too): synth_handheld
+  // (in its true cameras) 92.0% / 10.53 / 5.14 / 1.711 / 0.618 -> 93.3% / 9.91 / 4.78 / 1.304 /
+  // 0.588, its face-side views h10-h13 most (h11 18.1 -> 11.0 mm, h12 8.5 -> 6.3); data term
+  // alone 14.80 -> 11.00 mm; synth_straight_gantry 98.6% / 8.08 / 4.32 / 1.210 / 0.558 -> 98.6%
+  // / 8.09 / 4.24 / 1.122 / 0.526, data term 4.90 -> 4.77 mm; the demo's curly T group (hairmvs's
+  // own renders, whose gaps are dark) 98.4% / 3.47 / 2.38 / 0.301 / 0.243 -> 97.8% / 3.70 / 2.45
+  // / 0.289 / 0.229, at 1404 x 936 2.27 -> 2.28 mm. Signing the field by polarity instead (a
+  // dark strand's O negated, so that it matches only dark strands) was worse: synth_handheld
+  // 7.88 mm, the curly group 2.45.
+  bool dark_strands = true;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -71,10 +87,15 @@ struct OrientationFieldOptions {
       "scale the outer Gaussian part so that every filter sums to zero");
     v("min_positive_response_ratio", &min_positive_response_ratio,
       "bright-strand test: max signed response > ratio * max |response| (paper: 0)");
+    v("dark_strands", &dark_strands,
+      "dark strands make the field too (0: only bright ones, as the paper's Eq. 1)");
     v("filter_supersampling", &filter_supersampling,
       "n x n samples per tap averaged over its pixel (1 = point sampling)");
   }
   bool Check(std::string* error) const;
+  // r of the field's test, max signed response > r max |response|: min_positive_response_ratio
+  // for bright strands only, -1 (every pixel with a response) with dark_strands.
+  double SignedResponseRatio() const { return dark_strands ? -1.0 : min_positive_response_ratio; }
 };
 
 // What `hairmvs orientation_fields` does, for a workspace.

@@ -59,7 +59,7 @@ FloatMap DownsampleMask(const FloatMap& mask) {
 
 FloatMap ComputeOrientationLevelReference(const FloatMap& gray, const FloatMap& mask,
                                           const OrientationFilterBank& bank, double gamma,
-                                          double min_positive_response_ratio,
+                                          double signed_response_ratio,
                                           std::vector<FloatMap>* responses) {
   CheckInputs(gray, mask);
   const int w = gray.Width(), h = gray.Height(), n = bank.NumOrientations();
@@ -84,7 +84,7 @@ FloatMap ComputeOrientationLevelReference(const FloatMap& gray, const FloatMap& 
         }
         max_signed = std::max(max_signed, response);
       }
-      const bool valid = max_signed > min_positive_response_ratio * best_abs &&
+      const bool valid = max_signed > signed_response_ratio * best_abs &&
                          (mask.Empty() || mask.At(row, col) > 0);
       if (!valid) continue;
       const double confidence = std::pow(best_abs, gamma);
@@ -108,7 +108,7 @@ std::vector<FloatMap> ComputeOrientationFieldReference(const FloatMap& gray, con
     }
     levels.push_back(
         ComputeOrientationLevelReference(level_gray, level_mask, bank, options.confidence_gamma,
-                                         options.min_positive_response_ratio));
+                                         options.SignedResponseRatio()));
   }
   return levels;
 }
@@ -245,7 +245,7 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     k.setArg(arg++, h);
     k.setArg(arg++, out_stride);
     k.setArg(arg++, static_cast<float>(options_.confidence_gamma));
-    k.setArg(arg++, static_cast<float>(options_.min_positive_response_ratio));
+    k.setArg(arg++, static_cast<float>(options_.SignedResponseRatio()));
     const cl::NDRange local(config_.local_size_x, config_.local_size_y);
     const cl::NDRange global(RoundUpToMultiple(out_stride / vec, config_.local_size_x),
                              RoundUpToMultiple(h, config_.local_size_y));

@@ -5,9 +5,10 @@
 // Output per level: a 2-channel FloatMap, channel 0 = Re O, channel 1 = Im O, with
 //   Theta = argmax_theta |K_theta * I| (first maximum in theta order on ties),
 //   F     = (max_theta |K_theta * I|)^gamma,
-//   O     = F exp(2 i Theta) if max_theta (K_theta * I) > r max_theta |K_theta * I| (a bright
-//           strand; r = min_positive_response_ratio, the paper's 0 up to rounding) and the
-//           pixel is not masked, else 0.
+//   O     = F exp(2 i Theta) if max_theta (K_theta * I) > r max_theta |K_theta * I| and the
+//           pixel is not masked, else 0; r = OrientationFieldOptions::SignedResponseRatio():
+//           -1 with dark_strands (every pixel with a response), else
+//           min_positive_response_ratio (a bright strand: the paper's 0 up to rounding).
 // Theta is measured from image +x towards +y (clockwise on screen), modulo pi.
 // Levels: level 0 = the input; level k+1 = DownsampleHalf(level k), of size
 // ((W_k + 1) / 2, (H_k + 1) / 2); the same fixed-size filters at every level.
@@ -37,7 +38,7 @@ FloatMap DownsampleMask(const FloatMap& mask);
 // response of every filter (num_orientations maps), for tests.
 FloatMap ComputeOrientationLevelReference(const FloatMap& gray, const FloatMap& mask,
                                           const OrientationFilterBank& bank, double gamma,
-                                          double min_positive_response_ratio,
+                                          double signed_response_ratio,
                                           std::vector<FloatMap>* responses = nullptr);
 // All levels on the CPU (slow: for tests on small images).
 std::vector<FloatMap> ComputeOrientationFieldReference(const FloatMap& gray, const FloatMap& mask,

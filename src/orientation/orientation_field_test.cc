@@ -164,29 +164,34 @@ TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
       if (std::hypot(col - 60, row - 20) < 9) mask.At(row, col) = 0;
     }
   }
-  const OrientationFieldOptions options;
-  const OrientationFilterBank bank(options);
-  std::vector<Reference> references(3);
-  for (int l = 0; l < 3; ++l) {
-    Reference& ref = references[l];
-    ref.gray = l == 0 ? gray : DownsampleHalf(references[l - 1].gray);
-    ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
-    ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank, options.confidence_gamma,
-                                                 options.min_positive_response_ratio,
-                                                 &ref.responses);
-  }
-  // The default configuration, and one with 8-pixel vectors, a block size that leaves a
-  // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
-  for (const OrientationKernelConfig& config :
-       {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
-    OrientationFieldComputer computer(context_, options, config);
-    const std::vector<FloatMap> levels = computer.Compute(gray, mask);
-    ASSERT_EQ(levels.size(), 3u);
+  // Dark strands counted (the default) and bright strands only (the paper's rule).
+  for (bool dark_strands : {true, false}) {
+    OrientationFieldOptions options;
+    options.dark_strands = dark_strands;
+    const OrientationFilterBank bank(options);
+    std::vector<Reference> references(3);
     for (int l = 0; l < 3; ++l) {
-      ExpectMatchesReference(references[l], levels[l], options,
-                             "level " + std::to_string(l) + " vec " +
-                                 std::to_string(config.vector_width) + " block " +
-                                 std::to_string(config.block_size));
+      Reference& ref = references[l];
+      ref.gray = l == 0 ? gray : DownsampleHalf(references[l - 1].gray);
+      ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
+      ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank,
+                                                   options.confidence_gamma,
+                                                   options.SignedResponseRatio(), &ref.responses);
+    }
+    // The default configuration, and one with 8-pixel vectors, a block size that leaves a
+    // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
+    for (const OrientationKernelConfig& config :
+         {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
+      OrientationFieldComputer computer(context_, options, config);
+      const std::vector<FloatMap> levels = computer.Compute(gray, mask);
+      ASSERT_EQ(levels.size(), 3u);
+      for (int l = 0; l < 3; ++l) {
+        ExpectMatchesReference(references[l], levels[l], options,
+                               std::string(dark_strands ? "dark strands too" : "bright only") +
+                                   ", level " + std::to_string(l) + " vec " +
+                                   std::to_string(config.vector_width) + " block " +
+                                   std::to_string(config.block_size));
+      }
     }
   }
 }
@@ -281,16 +286,24 @@ TEST_F(OrientationFieldTest, RingsAreTangential) {
   EXPECT_LE(worst, 1.5);
 }
 
-// Dark strands on a bright background respond negatively at their own angle: O = 0 on them.
-TEST_F(OrientationFieldTest, DarkStrandsGiveZero) {
+// Dark strands on a bright background respond negatively at their own angle. With the paper's
+// rule (bright strands only) O = 0 on them; with dark_strands (the default) their field is that
+// of their bright twin, the image 1 - I, on its strands: the zero-sum filters respond to it
+// with the opposite sign and the same magnitude. (Between the strands every angle responds
+// weakly and alike, and the two images' rounding may pick different angles there.)
+TEST_F(OrientationFieldTest, DarkStrandsGiveZeroOrTheirBrightTwinsField) {
+  OrientationFieldOptions bright_only;
+  bright_only.dark_strands = false;
+  OrientationFieldComputer paper(context_, bright_only);
   OrientationFieldComputer computer(context_, OrientationFieldOptions());
   int checked = 0;
   for (double theta_deg : {0.0, 17.0, 45.0, 90.0, 133.5}) {
     FloatMap across;
     const FloatMap gray = Stripes(64, 64, theta_deg / kDegPerRad, 9.0, 0.7, 0.8, -0.6, &across);
     const FloatMap bright = Stripes(64, 64, theta_deg / kDegPerRad, 9.0, 0.7, 0.2, 0.6);
-    const FloatMap field = computer.ComputeLevel(gray, FloatMap());
-    const FloatMap bright_field = computer.ComputeLevel(bright, FloatMap());
+    const FloatMap field = paper.ComputeLevel(gray, FloatMap());
+    const FloatMap bright_field = paper.ComputeLevel(bright, FloatMap());
+    const FloatMap dark_field = computer.ComputeLevel(gray, FloatMap());
     for (int row = 16; row < 48; ++row) {
       for (int col = 16; col < 48; ++col) {
         if (std::abs(across.At(row, col)) > 0.3) continue;
@@ -298,6 +311,10 @@ TEST_F(OrientationFieldTest, DarkStrandsGiveZero) {
         EXPECT_EQ(field.At(row, col, 0), 0.0f) << theta_deg << " at " << row << "," << col;
         EXPECT_EQ(field.At(row, col, 1), 0.0f) << theta_deg << " at " << row << "," << col;
         EXPECT_GT(Confidence(bright_field, row, col), 0.3);  // the bright twin responds
+        for (int ch = 0; ch < 2; ++ch) {  // and so does the dark strand, alike
+          EXPECT_NEAR(dark_field.At(row, col, ch), bright_field.At(row, col, ch), 1e-4)
+              << theta_deg << " at " << row << "," << col;
+        }
       }
     }
   }
