@@ -67,6 +67,11 @@ void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy)
 // copied where the poses are the true ones already (the gantry sets).
 void UseTrueCameraPoses(const std::string& ground_truth_path,
                         const std::vector<std::string>& names, const std::string& sparse_path) {
+  if (!ExistsFile(JoinPaths(ground_truth_path, "cameras.npz"))) {
+    LOG(WARNING) << "No " << JoinPaths(ground_truth_path, "cameras.npz")
+                 << ": the workspace's poses are kept, and must be the true ones";
+    return;
+  }
   const GroundTruthCameras cameras = ReadGroundTruthCameras(ground_truth_path);
   Reconstruction model = ReadReconstruction(sparse_path);
   double max_angle_rad = 0, max_shift_m = 0;

@@ -393,6 +393,12 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   }
   options.in_true_cameras = false;
   EXPECT_NO_THROW(EvaluateDepthMaps(out, scene.gt, options));
+  // Nor does import_ground_truth need it: the workspace's poses are then kept.
+  const std::string kept = JoinPaths(scene.dir, "kept_poses");
+  ImportGroundTruth(scene.gt, scene.workspace, kept, ImportGroundTruthOptions());
+  for (const auto& [id, image] : ReadReconstruction(JoinPaths(kept, "sparse")).images) {
+    if (image.name == "v1.png") EXPECT_LT((image.ProjectionCenter() - centre).norm(), 1e-12);
+  }
 }
 
 TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
