@@ -68,7 +68,9 @@ struct OrientationFieldOptions {
   // alone 14.80 -> 11.00 mm; synth_straight_gantry 98.6% / 8.08 / 4.32 / 1.210 / 0.558 -> 98.6%
   // / 8.09 / 4.24 / 1.122 / 0.526, data term 4.90 -> 4.77 mm; the demo's curly T group (hairmvs's
   // own renders, whose gaps are dark) 98.4% / 3.47 / 2.38 / 0.301 / 0.243 -> 97.8% / 3.70 / 2.45
-  // / 0.289 / 0.229, at 1404 x 936 2.27 -> 2.28 mm. Signing the field by polarity instead (a
+  // / 0.289 / 0.229, at 1404 x 936 2.27 -> 2.28 mm; its straight renders (8 T groups) 97.6% /
+  // 5.92 / 2.66 / 0.752 / 0.351 -> 96.4% / 6.96 / 2.77 / 0.770 / 0.322, worse near the
+  // silhouettes (5.57 -> 6.73 mm). Signing the field by polarity instead (a
   // dark strand's O negated, so that it matches only dark strands) was worse: synth_handheld
   // 7.88 mm, the curly group 2.45.
   bool dark_strands = true;
