@@ -134,7 +134,7 @@ GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int
 
 GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras) {
   if (!in_true_cameras) return GroundTruthCameras();
-  const std::string path = JoinPaths(gt_path, "cameras.npz");
+  const std::string path = GroundTruthCamerasPath(gt_path);
   THROW_IF(!ExistsFile(path),
            "Missing " << path << ": the true cameras, in which each depth is compared with the "
                       << "truth (or evaluate with --in_true_cameras 0)");
@@ -143,7 +143,7 @@ GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_came
 
 GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
                           const std::string& name, int width, int height) {
-  const std::string path = JoinPaths(gt_path, "cameras.npz");
+  const std::string path = GroundTruthCamerasPath(gt_path);
   const int i = cameras.Find(name);
   THROW_IF(i < 0,
            path << ": no camera named " << name << " (or evaluate with --in_true_cameras 0)");

@@ -64,13 +64,17 @@ void WriteGroundTruthView(const std::string& gt_path, const std::string& image_n
   WriteNpz(GroundTruthViewPath(gt_path, image_name), arrays);
 }
 
+std::string GroundTruthCamerasPath(const std::string& gt_path) {
+  return JoinPaths(gt_path, "cameras.npz");
+}
+
 int GroundTruthCameras::Find(const std::string& name) const {
   const auto it = std::find(names.begin(), names.end(), name);
   return it == names.end() ? -1 : static_cast<int>(it - names.begin());
 }
 
 GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
-  const std::string path = JoinPaths(gt_path, "cameras.npz");
+  const std::string path = GroundTruthCamerasPath(gt_path);
   const auto arrays = ReadNpz(path);
   GroundTruthCameras cameras;
   cameras.names = NpzEntry(arrays, "names", path).Strings();
@@ -130,7 +134,7 @@ void WriteGroundTruthCameras(const std::string& gt_path, const GroundTruthCamera
   arrays["height"] = NpyArray::Scalar<int64_t>(cameras.height);
   arrays["hair_centre"] = NpyArray::FromVector(
       std::vector<double>{cameras.hair_centre(0), cameras.hair_centre(1), cameras.hair_centre(2)});
-  WriteNpz(JoinPaths(gt_path, "cameras.npz"), arrays);
+  WriteNpz(GroundTruthCamerasPath(gt_path), arrays);
 }
 
 GroundTruthStrands ReadGroundTruthStrands(const std::string& gt_path) {

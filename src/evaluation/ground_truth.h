@@ -29,6 +29,8 @@ struct GroundTruthView {
 // gt_path/<stem of image_name>.npz ("g0_c.png" -> gt_path/g0_c.npz). Throws hairmvs::Error
 // naming the file when it is missing or its arrays are not H x W float32 / uint8.
 std::string GroundTruthViewPath(const std::string& gt_path, const std::string& image_name);
+// gt_path/cameras.npz.
+std::string GroundTruthCamerasPath(const std::string& gt_path);
 GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::string& image_name);
 void WriteGroundTruthView(const std::string& gt_path, const std::string& image_name,
                           const GroundTruthView& view);

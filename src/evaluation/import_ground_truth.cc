@@ -67,8 +67,9 @@ void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy)
 // copied where the poses are the true ones already (the gantry sets).
 void UseTrueCameraPoses(const std::string& ground_truth_path,
                         const std::vector<std::string>& names, const std::string& sparse_path) {
-  if (!ExistsFile(JoinPaths(ground_truth_path, "cameras.npz"))) {
-    LOG(WARNING) << "No " << JoinPaths(ground_truth_path, "cameras.npz")
+  const std::string cameras_path = GroundTruthCamerasPath(ground_truth_path);
+  if (!ExistsFile(cameras_path)) {
+    LOG(WARNING) << "No " << cameras_path
                  << ": the workspace's poses are kept, and must be the true ones";
     return;
   }
@@ -78,8 +79,8 @@ void UseTrueCameraPoses(const std::string& ground_truth_path,
   for (auto& [id, image] : model.images) {
     if (std::find(names.begin(), names.end(), image.name) == names.end()) continue;
     const int i = cameras.Find(image.name);
-    THROW_IF(i < 0, JoinPaths(ground_truth_path, "cameras.npz")
-                        << ": no camera named " << image.name << ", whose truth is imported");
+    THROW_IF(i < 0, cameras_path << ": no camera named " << image.name
+                                 << ", whose truth is imported");
     const Eigen::Quaterniond rotation(cameras.R[i]);
     max_angle_rad =
         std::max(max_angle_rad, rotation.angularDistance(image.cam_from_world_rotation));
@@ -89,8 +90,7 @@ void UseTrueCameraPoses(const std::string& ground_truth_path,
     const Eigen::Matrix3d K = model.cameras.at(image.camera_id).CalibrationMatrix();
     if ((K - cameras.K).norm() > 1e-6 * cameras.K(0, 0)) {
       LOG(WARNING) << "Image " << image.name << ": the workspace's intrinsics differ from "
-                   << JoinPaths(ground_truth_path, "cameras.npz")
-                   << "'s; the true depths are written as they are";
+                   << cameras_path << "'s; the true depths are written as they are";
     }
   }
   if (max_angle_rad < 1e-9 && max_shift_m < 1e-9) return;

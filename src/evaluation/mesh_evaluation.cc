@@ -122,7 +122,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   for (const std::string& name : names) {
     const int i = cameras.Find(name);
     THROW_IF(i < 0, "Image " << name << " has no camera in "
-                             << JoinPaths(ground_truth_path, "cameras.npz"));
+                             << GroundTruthCamerasPath(ground_truth_path));
     const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
     const Eigen::Matrix3d Rt = cameras.R[i].transpose();
     for (int r = 0; r < view.depth.Height(); ++r) {
