@@ -103,8 +103,8 @@ struct DepthEvaluationOptions {
   // ones (the gantry sets: sparse/ holds the true poses); where they come from COLMAP's mapper
   // (synth_handheld: its poses are 0.24-0.43 degrees off the truth), the same index is a
   // different ray, 1-3 px away at the hair (h13: 13 px), and the per-pixel error of a layered
-  // hair then measures the poses as much as the depths. The depths a data set's own true maps
-  // give (import_ground_truth) live in the true cameras: evaluate those with this off.
+  // hair then measures the poses as much as the depths. import_ground_truth writes the true
+  // poses with the true maps, so those meet the truth exactly in either mode.
   bool in_true_cameras = true;
 
   template <typename Visitor>
