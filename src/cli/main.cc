@@ -47,10 +47,10 @@ int main(int argc, char** argv) {
   }
   try {
     return it->second.run(argc, argv);
-  } catch (const hairmvs::Error& e) {
-    std::fprintf(stderr, "ERROR: %s\n", e.what());
-    return 1;
-  } catch (const std::exception& e) {
+  } catch (const std::exception& e) {  // hairmvs::Error and the others alike
+    // What the command printed (its options, its progress) comes first, so that the error is
+    // the last line of a log that captures both streams.
+    std::fflush(stdout);
     std::fprintf(stderr, "ERROR: %s\n", e.what());
     return 1;
   }

@@ -25,6 +25,11 @@ void RequireShape(const NpyArray& array, const std::vector<size_t>& shape,
            what << ": expected shape " << text(shape) << ", found " << text(array.shape));
 }
 
+// A wrong --ground_truth_path is named as such, not as the first file missing from it.
+void RequireGroundTruthDir(const std::string& gt_path) {
+  RequireDir(gt_path, "ground truth folder (a data set's gt/, --ground_truth_path)");
+}
+
 }  // namespace
 
 std::string GroundTruthViewPath(const std::string& gt_path, const std::string& image_name) {
@@ -36,6 +41,7 @@ std::string GroundTruthViewPath(const std::string& gt_path, const std::string& i
 }
 
 GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::string& image_name) {
+  RequireGroundTruthDir(gt_path);
   const std::string path = GroundTruthViewPath(gt_path, image_name);
   const auto arrays = ReadNpz(path);
   const NpyArray& depth = NpzEntry(arrays, "depth", path);
@@ -74,6 +80,7 @@ int GroundTruthCameras::Find(const std::string& name) const {
 }
 
 GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
+  RequireGroundTruthDir(gt_path);
   const std::string path = GroundTruthCamerasPath(gt_path);
   const auto arrays = ReadNpz(path);
   GroundTruthCameras cameras;
@@ -138,6 +145,7 @@ void WriteGroundTruthCameras(const std::string& gt_path, const GroundTruthCamera
 }
 
 GroundTruthStrands ReadGroundTruthStrands(const std::string& gt_path) {
+  RequireGroundTruthDir(gt_path);
   const std::string points_path = JoinPaths(gt_path, "strands_points.npy");
   const std::string offsets_path = JoinPaths(gt_path, "strands_offsets.npy");
   const NpyArray points = ReadNpy(points_path);

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -89,6 +90,25 @@ TEST(GroundTruth, StrandDistanceMatchesBruteForce) {
   EXPECT_GT(distance.NumSamples(), 5u * 0.006 / 2e-4);
   // A stored point is on its strand.
   EXPECT_NEAR(distance.Distance(strands.points[3].cast<double>()), 0.0, 1e-7);
+}
+
+TEST(GroundTruth, MissingFolderIsNamedAsTheGroundTruth) {
+  const std::string missing = JoinPaths(::testing::TempDir(), "hairmvs_gt_no_such_folder");
+  std::filesystem::remove_all(missing);
+  const std::vector<std::function<void()>> readers = {
+      [&] { ReadGroundTruthView(missing, "v0.png"); },
+      [&] { ReadGroundTruthCameras(missing); },
+      [&] { ReadGroundTruthStrands(missing); }};
+  for (const auto& read : readers) {
+    try {
+      read();
+      ADD_FAILURE() << "no error for " << missing;
+    } catch (const Error& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
+      EXPECT_NE(message.find(missing), std::string::npos) << message;
+    }
+  }
 }
 
 TEST(GroundTruth, FilesRoundTrip) {
