@@ -442,6 +442,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   const Workspace workspace = Workspace::Read(workspace_path);
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
+  // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
+  // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
+  if (workspace.ImagesWithoutMask().empty() &&
+      std::all_of(names.begin(), names.end(),
+                  [&](const std::string& name) { return workspace.MaskPath(name).empty(); })) {
+    LOG(WARNING) << JoinPaths(workspace_path, "masks")
+                 << " does not exist: every pixel is matched, the background too, and each "
+                    "depth range comes from all of the view's sparse points. With hair masks "
+                    "(masks/<image name>.png, 255 = hair) the depth maps cover the hair only, "
+                    "within the masks' visual hull";
+  }
 
   const SourceViewOptions source_options =
       source_views != nullptr ? *source_views : SourceViewOptions();

@@ -112,8 +112,14 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   options.write_png = true;
   options.write_cost_volume = true;
   StageTimings timings;
+  testing::internal::CaptureStderr();
   const OrientationStereoResult result =
       RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  const std::string log = testing::internal::GetCapturedStderr();
+  // A workspace fresh from colmap image_undistorter has no masks: said once.
+  EXPECT_NE(log.find(JoinPaths(path, "masks") + " does not exist: every pixel is matched"),
+            std::string::npos)
+      << log;
   EXPECT_EQ(result.num_views, 1);
   const Workspace workspace = Workspace::Read(path);
   ASSERT_TRUE(ExistsFile(workspace.DepthMapPath("v0.png")));
