@@ -25,9 +25,10 @@ void RequireShape(const NpyArray& array, const std::vector<size_t>& shape,
            what << ": expected shape " << text(shape) << ", found " << text(array.shape));
 }
 
-// A wrong --ground_truth_path is named as such, not as the first file missing from it.
+// A wrong folder (--ground_truth_path, synthesize's --strands_path) is named as such, not as
+// the first file missing from it.
 void RequireGroundTruthDir(const std::string& gt_path) {
-  RequireDir(gt_path, "ground truth folder (a data set's gt/, --ground_truth_path)");
+  RequireDir(gt_path, "ground truth folder (a data set's gt/)");
 }
 
 }  // namespace
