@@ -248,8 +248,18 @@ void WriteImage(const std::string& path, const FloatMap& image) {
   }
   cv::Mat merged;
   cv::merge(planes, merged);
+  WriteImage(path, merged);
+}
+
+void WriteImage(const std::string& path, const cv::Mat& image) {
   WritePathAtomically(path, [&](const std::string& tmp_path) {
-    THROW_IF(!cv::imwrite(tmp_path, merged), "Cannot write image " << path);
+    bool written = false;
+    try {
+      written = cv::imwrite(tmp_path, image);
+    } catch (const cv::Exception& e) {  // e.g. an extension OpenCV has no writer for
+      HAIRMVS_THROW("Cannot write image " << path << ": " << e.err);
+    }
+    THROW_IF(!written, "Cannot write image " << path);
   });
 }
 

@@ -10,6 +10,10 @@
 #include "colmap_ext/reconstruction.h"
 #include "src/core/float_map.h"
 
+namespace cv {
+class Mat;
+}  // namespace cv
+
 namespace hairmvs {
 
 class Workspace {
@@ -61,5 +65,8 @@ FloatMap ReadMask(const std::string& path, int width, int height);
 // Writes a 1- or 3-channel (R, G, B) map with values in [0, 1] as an 8-bit image (format from
 // the extension, e.g. .png), atomically. Values are clamped and rounded.
 void WriteImage(const std::string& path, const FloatMap& image);
+// Writes an OpenCV image (grey or B, G, R, as cv::imwrite takes it) atomically; throws
+// hairmvs::Error naming `path` if OpenCV cannot write it.
+void WriteImage(const std::string& path, const cv::Mat& image);
 
 }  // namespace hairmvs

@@ -118,6 +118,17 @@ TEST(Images, GrayRgbAndSixteenBit) {
   for (size_t i = 0; i < picture.Data().size(); ++i) {
     EXPECT_NEAR(back.Data()[i], picture.Data()[i], 0.5 / 255 + 1e-6);
   }
+  // The OpenCV overload: B, G, R bytes as imwrite takes them; a format OpenCV cannot write
+  // is named and leaves nothing behind.
+  cv::Mat bytes(2, 3, CV_8UC3, cv::Scalar(10, 20, 30));
+  WriteImage(JoinPaths(dir, "bgr.png"), bytes);
+  const FloatMap read = ReadImageRgb(JoinPaths(dir, "bgr.png"));
+  EXPECT_NEAR(read.At(1, 2, 0), 30 / 255.0, 1e-6);
+  EXPECT_NEAR(read.At(1, 2, 2), 10 / 255.0, 1e-6);
+  EXPECT_NE(ErrorOf([&] { WriteImage(JoinPaths(dir, "bgr.nosuchformat"), bytes); })
+                .find("bgr.nosuchformat"),
+            std::string::npos);
+  EXPECT_FALSE(ExistsFile(JoinPaths(dir, "bgr.nosuchformat")));
   EXPECT_NE(ErrorOf([&] { ReadImageGray(JoinPaths(dir, "none.png")); }).find("none.png"),
             std::string::npos);
   WriteFileAtomically(JoinPaths(dir, "junk.png"), [](std::ostream& out) { out << "junk"; });

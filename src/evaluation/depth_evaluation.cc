@@ -2,7 +2,6 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <Eigen/Core>
@@ -337,9 +336,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
       for (const auto& [suffix, image] : {std::pair(".error.png", &error_image),
                                           std::pair(".signed_error.png", &signed_image)}) {
         const std::string png = JoinPaths(output_path, name + suffix);
-        WritePathAtomically(png, [&](const std::string& tmp) {
-          THROW_IF(!cv::imwrite(tmp, *image), "Cannot write " << png);
-        });
+        WriteImage(png, *image);
       }
     }
     pooled.Append(samples);

@@ -1,7 +1,6 @@
 // `hairmvs orientation_fields`: the orientation field of every image of a workspace.
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -49,9 +48,7 @@ void WriteOrientationPng(const std::string& path, const FloatMap& field) {
   }
   cv::Mat bgr;
   cv::cvtColor(hsv, bgr, cv::COLOR_HSV2BGR);
-  WritePathAtomically(path, [&bgr](const std::string& tmp_path) {
-    THROW_IF(!cv::imwrite(tmp_path, bgr), "Could not write " << tmp_path);
-  });
+  WriteImage(path, bgr);
 }
 
 std::string PngPathFor(const std::string& bin_path) {

@@ -11,7 +11,6 @@
 #include <memory>
 #include <optional>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
@@ -248,9 +247,7 @@ void WriteDepthPng(const std::string& path, const FloatMap& depth) {
       if (!(depth.At(row, col) > 0)) colour.at<cv::Vec3b>(row, col) = cv::Vec3b(0, 0, 0);
     }
   }
-  WritePathAtomically(path, [&](const std::string& tmp) {
-    THROW_IF(!cv::imwrite(tmp, colour), "cannot write " << path);
-  });
+  WriteImage(path, colour);
 }
 
 void WriteNormalPng(const std::string& path, const FloatMap& normals) {
@@ -266,9 +263,7 @@ void WriteNormalPng(const std::string& path, const FloatMap& normals) {
       if (normals.At(row, col, 2) == 0) px = cv::Vec3b(0, 0, 0);
     }
   }
-  WritePathAtomically(path, [&](const std::string& tmp) {
-    THROW_IF(!cv::imwrite(tmp, colour), "cannot write " << path);
-  });
+  WriteImage(path, colour);
 }
 
 // Reads and caches the per-view data (camera, orientation pyramid, colour pyramid).

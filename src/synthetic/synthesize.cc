@@ -2,7 +2,6 @@
 
 #include <nlohmann/json.hpp>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +9,7 @@
 #include <sstream>
 
 #include "colmap_ext/reconstruction.h"
+#include "colmap_ext/workspace.h"
 #include "src/core/depth_geometry.h"
 #include "src/core/enum_names.h"
 #include "src/core/file_util.h"
@@ -35,11 +35,6 @@ std::string Stem(const std::string& name) {
   return dot == std::string::npos ? name : name.substr(0, dot);
 }
 
-void WritePng(const std::string& path, const cv::Mat& image) {
-  WritePathAtomically(path, [&](const std::string& tmp) {
-    THROW_IF(!cv::imwrite(tmp, image), "Could not write image " << path);
-  });
-}
 
 cv::Mat RgbToBgrMat(const std::vector<uint8_t>& rgb, int width, int height) {
   cv::Mat mat(height, width, CV_8UC3);
@@ -208,7 +203,7 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
     result.seconds_render += timer.ElapsedSeconds();
     timer.Restart();
     const RenderedView& r = renders.back();
-    WritePng(JoinPaths(dense_path, "images", views[v].name), RgbToBgrMat(r.rgb, W, H));
+    WriteImage(JoinPaths(dense_path, "images", views[v].name), RgbToBgrMat(r.rgb, W, H));
     cv::Mat mask(H, W, CV_8UC1, cv::Scalar(0));
     for (int row = 0; row < H; ++row) {
       for (int col = 0; col < W; ++col) {
@@ -220,13 +215,13 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
         if (r.label[p] == kLabelHair) ++hair_pixels;
       }
     }
-    WritePng(JoinPaths(dense_path, "masks", views[v].name + ".png"), mask);
+    WriteImage(JoinPaths(dense_path, "masks", views[v].name + ".png"), mask);
     GroundTruthView gt;
     gt.depth = r.depth;
     gt.label = r.label;
     WriteGroundTruthView(gt_path, views[v].name, gt);
-    WritePng(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_depth.png"), DepthPicture(r.depth));
-    WritePng(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_label.png"),
+    WriteImage(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_depth.png"), DepthPicture(r.depth));
+    WriteImage(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_label.png"),
              LabelPicture(r.label, W, H));
     result.seconds_write += timer.ElapsedSeconds();
   }
