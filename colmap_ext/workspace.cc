@@ -105,6 +105,18 @@ std::string Workspace::MaskPath(const std::string& name) const {
   return "";
 }
 
+StereoCamera Workspace::ViewCamera(const std::string& name) const {
+  const Camera& camera = CameraOf(name);
+  const Image& image = ImageByName(name);
+  StereoCamera view;
+  view.K = camera.CalibrationMatrix();
+  view.R = image.R();
+  view.t = image.t();
+  view.width = static_cast<int>(camera.width);
+  view.height = static_cast<int>(camera.height);
+  return view;
+}
+
 std::string Workspace::StereoPath() const { return JoinPaths(path_, "stereo"); }
 
 std::string Workspace::DepthMapPath(const std::string& name, const std::string& type) const {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "colmap_ext/reconstruction.h"
+#include "src/core/depth_geometry.h"
 #include "src/core/float_map.h"
 
 namespace cv {
@@ -33,6 +34,9 @@ class Workspace {
   const Camera& CameraOf(const std::string& name) const;
 
   std::string ImagePath(const std::string& name) const;
+  // The camera of image `name` (its intrinsics and pose) on its image's pixel grid; Scaled()
+  // carries it to a smaller map's (COLMAP's max_image_size, a coarse grid).
+  StereoCamera ViewCamera(const std::string& name) const;
   // "" when the workspace has no masks or this image has none.
   std::string MaskPath(const std::string& name) const;
   // With a masks folder, the images that have no mask in it (Read warns about them).

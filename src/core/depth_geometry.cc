@@ -16,6 +16,46 @@ Eigen::Vector3d BackProjectPixel(const Eigen::Matrix3d& K, double col, double ro
   return Eigen::Vector3d(x * depth, y * depth, depth);
 }
 
+StereoCamera StereoCamera::Scaled(int new_width, int new_height) const {
+  StereoCamera scaled = *this;
+  const double sx = static_cast<double>(new_width) / width;
+  const double sy = static_cast<double>(new_height) / height;
+  // Continuous image coordinates scale exactly in the SfM convention (the image spans [0, W]).
+  scaled.K.row(0) *= sx;
+  scaled.K.row(1) *= sy;
+  scaled.width = new_width;
+  scaled.height = new_height;
+  return scaled;
+}
+
+StereoCamera StereoCamera::PyramidLevel(int level) const {
+  CHECK_GE(level, 0);
+  StereoCamera scaled = *this;
+  for (int l = 0; l < level; ++l) {
+    scaled.K.row(0) *= 0.5;
+    scaled.K.row(1) *= 0.5;
+    scaled.width = (scaled.width + 1) / 2;
+    scaled.height = (scaled.height + 1) / 2;
+  }
+  return scaled;
+}
+
+Eigen::Vector3d StereoCamera::BackProject(int col, int row, double depth) const {
+  return R.transpose() * (BackProjectPixel(K, col, row, depth) - t);
+}
+
+bool StereoCamera::Project(const Eigen::Vector3d& world, int* col, int* row,
+                           double* depth) const {
+  const Eigen::Vector3d x = K * (R * world + t);
+  if (!(x.z() > 0)) return false;
+  const double c = std::floor(x.x() / x.z()), r = std::floor(x.y() / x.z());
+  if (!(c >= 0 && r >= 0 && c < width && r < height)) return false;
+  *col = static_cast<int>(c);
+  *row = static_cast<int>(r);
+  *depth = x.z();
+  return true;
+}
+
 FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
                                double max_slope) {
   CHECK_EQ(depth.Channels(), 1);

@@ -13,6 +13,31 @@ namespace hairmvs {
 // depth * K^-1 * (col + 0.5, row + 0.5, 1).
 Eigen::Vector3d BackProjectPixel(const Eigen::Matrix3d& K, double col, double row, double depth);
 
+// A pinhole camera on a width x height pixel grid: X_cam = R X_world + t. The stereo's cameras
+// at the processing resolution and its pyramid levels, the evaluators' workspace and true
+// cameras (ViewCamera in colmap_ext/workspace.h builds a view's).
+struct StereoCamera {
+  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
+  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d t = Eigen::Vector3d::Zero();
+  int width = 0;
+  int height = 0;
+
+  Eigen::Vector3d Center() const { return -R.transpose() * t; }
+  // The same camera for an image of width x height covering the same extent (a resized image).
+  StereoCamera Scaled(int new_width, int new_height) const;
+  // The camera of level `level` of the 2 x 2 box pyramid (DownsampleHalf in
+  // src/orientation/orientation_field.h): image coordinates halve exactly at every level and the
+  // size is ceil(size / 2^level). Not Scaled(ceil(W / 2^level), ...): for an odd size the last
+  // pixel of a level reaches beyond the image, so the level does not cover the same extent.
+  StereoCamera PyramidLevel(int level) const;
+  // The world point seen at pixel (col, row) with z-depth `depth`.
+  Eigen::Vector3d BackProject(int col, int row, double depth) const;
+  // The pixel a world point lands in and its z-depth; false when it is behind the camera or
+  // off the grid.
+  bool Project(const Eigen::Vector3d& world, int* col, int* row, double* depth) const;
+};
+
 // Camera-frame unit normals (3 channels: x, y, z) of the surface of a z-depth map, from
 // central differences of the back-projected neighbours (one-sided where one neighbour is
 // missing or across a discontinuity), oriented towards the camera (n . X < 0). 0 where the

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <utility>
 
 namespace hairmvs {
 namespace {
@@ -22,6 +24,40 @@ TEST(DepthGeometry, BackProjectUsesPixelCentres) {
   EXPECT_NEAR(x(0) / x(2), 10.5, 1e-12);
   EXPECT_NEAR(x(1) / x(2), 5.5, 1e-12);
   EXPECT_DOUBLE_EQ(X(2), 1.5);
+}
+
+// A camera's pixel round-trips through the world and back, on its own grid and on a scaled
+// one (where the same world point lands at the scaled pixel centre's cell); off the grid and
+// behind the camera it has no pixel.
+TEST(DepthGeometry, StereoCameraProjectsWhatItBackProjects) {
+  StereoCamera camera;
+  camera.K = TestK();
+  camera.R = Eigen::AngleAxisd(0.2, Eigen::Vector3d(0.3, 1, 0).normalized()).toRotationMatrix();
+  camera.t = Eigen::Vector3d(0.05, -0.02, 0.6);
+  camera.width = 64;
+  camera.height = 48;
+  EXPECT_TRUE(camera.Center().isApprox(-camera.R.transpose() * camera.t));
+  for (const auto& [col, row] : {std::pair(0, 0), std::pair(63, 47), std::pair(17, 30)}) {
+    const Eigen::Vector3d world = camera.BackProject(col, row, 0.8);
+    int c = -1, r = -1;
+    double z = 0;
+    ASSERT_TRUE(camera.Project(world, &c, &r, &z));
+    EXPECT_EQ(c, col);
+    EXPECT_EQ(r, row);
+    EXPECT_NEAR(z, 0.8, 1e-12);
+    // Half the grid: pixel (col, row) lies in cell (col / 2, row / 2).
+    ASSERT_TRUE(camera.Scaled(32, 24).Project(world, &c, &r, &z));
+    EXPECT_EQ(c, col / 2);
+    EXPECT_EQ(r, row / 2);
+    EXPECT_NEAR(z, 0.8, 1e-12);
+  }
+  int c, r;
+  double z;
+  const Eigen::Vector3d centre_ray = camera.BackProject(31, 23, 1.0) - camera.Center();
+  EXPECT_FALSE(camera.Project(camera.Center() - centre_ray, &c, &r, &z));  // behind
+  EXPECT_FALSE(camera.Project(camera.BackProject(0, 0, 1.0) +
+                                  camera.R.transpose() * Eigen::Vector3d(-0.1, 0, 0),
+                              &c, &r, &z));  // left of the grid
 }
 
 // Depth of the plane n . X = c along the ray through pixel (col, row).

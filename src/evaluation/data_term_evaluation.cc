@@ -106,7 +106,7 @@ int FirstFinePixel(int coarse, int fine_size, int coarse_size) {
 // volume's grid, in one coarse pixel: the true depths of a coarse pixel are those of the image
 // pixels whose centres fall in it where the two cameras are the same.
 void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
-                  const GridCamera& truth_camera, const GridCamera& grid_camera,
+                  const StereoCamera& truth_camera, const StereoCamera& grid_camera,
                   double min_hair_fraction, DataTermSamples* samples) {
   const FloatMap& cost = volume.cost;
   const std::vector<double>& depths = volume.label_depths;
@@ -203,12 +203,12 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
     DataTermSamples samples;
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
-    const GridCamera truth_camera =
+    const StereoCamera truth_camera =
         options.in_true_cameras
-            ? TrueGridCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
-            : WorkspaceGridCamera(ws, name, gt_width, gt_height);
+            ? TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
+            : ws.ViewCamera(name).Scaled(gt_width, gt_height);
     EvaluateView(volume, gt, truth_camera,
-                 WorkspaceGridCamera(ws, name, volume.cost.Width(), volume.cost.Height()),
+                 ws.ViewCamera(name).Scaled(volume.cost.Width(), volume.cost.Height()),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);

@@ -235,10 +235,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
     const int width = depth.Width(), height = depth.Height();
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
-    const GridCamera camera = WorkspaceGridCamera(ws, name, width, height);
-    std::optional<GridCamera> true_camera;
+    const StereoCamera camera = ws.ViewCamera(name).Scaled(width, height);
+    std::optional<StereoCamera> true_camera;
     if (options.in_true_cameras) {
-      true_camera = TrueGridCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);
+      true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);
     }
 
     // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in

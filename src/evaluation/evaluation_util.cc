@@ -4,7 +4,6 @@
 #include <cmath>
 #include <numeric>
 
-#include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 
@@ -100,38 +99,6 @@ void WriteJsonSummary(const std::string& path, const nlohmann::json& json) {
   WriteFileAtomically(path, [&text](std::ostream& out) { out << text << "\n"; }, false);
 }
 
-Eigen::Vector3d GridCamera::BackProject(int col, int row, double depth) const {
-  return R.transpose() * (BackProjectPixel(K, col, row, depth) - t);
-}
-
-bool GridCamera::Project(const Eigen::Vector3d& world, int* col, int* row, double* depth) const {
-  const Eigen::Vector3d x = K * (R * world + t);
-  if (!(x.z() > 0)) return false;
-  const double c = std::floor(x.x() / x.z()), r = std::floor(x.y() / x.z());
-  if (!(c >= 0 && r >= 0 && c < width && r < height)) return false;
-  *col = static_cast<int>(c);
-  *row = static_cast<int>(r);
-  *depth = x.z();
-  return true;
-}
-
-GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int width,
-                               int height) {
-  const Camera& camera = ws.CameraOf(name);
-  const Image& image = ws.ImageByName(name);
-  GridCamera grid;
-  // SfM convention: the image edges map to the grid's edges, so pixel-centre coordinates
-  // scale by the size ratio.
-  grid.K = camera.CalibrationMatrix();
-  grid.K.row(0) *= static_cast<double>(width) / camera.width;
-  grid.K.row(1) *= static_cast<double>(height) / camera.height;
-  grid.R = image.R();
-  grid.t = image.t();
-  grid.width = width;
-  grid.height = height;
-  return grid;
-}
-
 GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras) {
   if (!in_true_cameras) return GroundTruthCameras();
   const std::string path = GroundTruthCamerasPath(gt_path);
@@ -141,7 +108,7 @@ GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_came
   return ReadGroundTruthCameras(gt_path);
 }
 
-GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
+StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
                           const std::string& name, int width, int height) {
   const std::string path = GroundTruthCamerasPath(gt_path);
   const int i = cameras.Find(name);
@@ -150,7 +117,7 @@ GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& 
   THROW_IF(cameras.width != width || cameras.height != height,
            path << ": cameras of " << cameras.width << " x " << cameras.height << " px, but "
                 << GroundTruthViewPath(gt_path, name) << " is " << width << " x " << height);
-  GridCamera grid;
+  StereoCamera grid;
   grid.K = cameras.K;
   grid.R = cameras.R[i];
   grid.t = cameras.t[i];

@@ -4,13 +4,13 @@
 
 #include <nlohmann/json.hpp>
 
-#include <Eigen/Core>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
+#include "src/core/depth_geometry.h"
 #include "src/core/float_map.h"
 #include "src/evaluation/ground_truth.h"
 
@@ -51,33 +51,15 @@ std::string EvaluationTable(const std::string& header, const std::vector<Metrics
   return table;
 }
 
-// A view's camera on a width x height pixel grid (SfM convention: pixel (col, row) is centred
-// at (col + 0.5, row + 0.5)) and its pose, X_cam = R X_world + t: how the evaluators carry a
-// depth between the workspace's camera, in which the maps are estimated, and the true camera,
-// in which the truth was rendered (DepthEvaluationOptions::in_true_cameras).
-struct GridCamera {
-  Eigen::Matrix3d K;
-  Eigen::Matrix3d R;
-  Eigen::Vector3d t;
-  int width = 0;
-  int height = 0;
-
-  // The world point seen at pixel (col, row) with z-depth `depth`.
-  Eigen::Vector3d BackProject(int col, int row, double depth) const;
-  // The pixel a world point lands in and its z-depth; false when it is behind the camera or
-  // off the grid.
-  bool Project(const Eigen::Vector3d& world, int* col, int* row, double* depth) const;
-};
-// The workspace's camera of image `name`, scaled to a width x height grid.
-GridCamera WorkspaceGridCamera(const Workspace& ws, const std::string& name, int width,
-                               int height);
 // gt_path/cameras.npz when `in_true_cameras` (empty cameras otherwise). Throws hairmvs::Error
 // naming the file, and the way to compare at the same pixels instead, when it is missing.
 GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras);
 // The camera `name` was rendered with (gt_path/cameras.npz, read into `cameras`), on the true
-// maps' grid of width x height. Throws hairmvs::Error naming the file when the camera is
-// absent or of another size.
-GridCamera TrueGridCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
+// maps' grid of width x height: how the evaluators carry a depth between the workspace's
+// camera (ViewCamera), in which the maps are estimated, and the true camera
+// (DepthEvaluationOptions::in_true_cameras). Throws hairmvs::Error naming the file when the
+// camera is absent or of another size.
+StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
                           const std::string& name, int width, int height);
 
 // "Section.field" checks shared by the option structs.

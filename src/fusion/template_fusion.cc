@@ -204,14 +204,12 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       view.depth = ReadMat(depth_path);
       THROW_IF(view.depth.Channels() != 1, depth_path << ": a depth map needs 1 channel, not "
                                                       << view.depth.Channels());
-      const Camera& camera = workspace.CameraOf(name);
-      const Image& image = workspace.ImageByName(name);
-      view.K = camera.CalibrationMatrix();
       // COLMAP writes smaller depth maps with --PatchMatchStereo.max_image_size.
-      view.K.row(0) *= static_cast<double>(view.depth.Width()) / camera.width;
-      view.K.row(1) *= static_cast<double>(view.depth.Height()) / camera.height;
-      view.R = image.R();
-      view.t = image.t();
+      const StereoCamera camera =
+          workspace.ViewCamera(name).Scaled(view.depth.Width(), view.depth.Height());
+      view.K = camera.K;
+      view.R = camera.R;
+      view.t = camera.t;
       const std::string normal_path = workspace.NormalMapPath(name, type);
       if (ExistsFile(normal_path)) {
         view.normal = ReadMat(normal_path);

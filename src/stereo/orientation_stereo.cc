@@ -295,14 +295,7 @@ class ViewLoader {
 
   // The camera at the processing resolution.
   StereoCamera ProcessingCamera(const std::string& name) const {
-    const Camera& camera = workspace_.CameraOf(name);
-    const Image& image = workspace_.ImageByName(name);
-    StereoCamera full;
-    full.K = camera.CalibrationMatrix();
-    full.R = image.R();
-    full.t = image.t();
-    full.width = static_cast<int>(camera.width);
-    full.height = static_cast<int>(camera.height);
+    const StereoCamera full = workspace_.ViewCamera(name);
     int w, h;
     ProcessingSize(full.width, full.height, options_.max_image_size, &w, &h);
     return full.Scaled(w, h);

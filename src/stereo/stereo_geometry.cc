@@ -8,30 +8,6 @@
 
 namespace hairmvs {
 
-StereoCamera StereoCamera::Scaled(int new_width, int new_height) const {
-  StereoCamera scaled = *this;
-  const double sx = static_cast<double>(new_width) / width;
-  const double sy = static_cast<double>(new_height) / height;
-  // Continuous image coordinates scale exactly in the SfM convention (the image spans [0, W]).
-  scaled.K.row(0) *= sx;
-  scaled.K.row(1) *= sy;
-  scaled.width = new_width;
-  scaled.height = new_height;
-  return scaled;
-}
-
-StereoCamera StereoCamera::PyramidLevel(int level) const {
-  CHECK_GE(level, 0);
-  StereoCamera scaled = *this;
-  for (int l = 0; l < level; ++l) {
-    scaled.K.row(0) *= 0.5;
-    scaled.K.row(1) *= 0.5;
-    scaled.width = (scaled.width + 1) / 2;
-    scaled.height = (scaled.height + 1) / 2;
-  }
-  return scaled;
-}
-
 std::array<float, 16> ViewProjection::Packed() const {
   std::array<float, 16> packed{};
   for (int r = 0; r < 3; ++r) {

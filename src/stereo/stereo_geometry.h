@@ -9,27 +9,11 @@
 #include <array>
 
 #include "hairmvs/orientation_stereo.h"
+#include "src/core/depth_geometry.h"  // StereoCamera
 #include "src/core/float_map.h"
 
 namespace hairmvs {
 
-// A pinhole camera at the processing resolution: X_cam = R X_world + t.
-struct StereoCamera {
-  Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
-  Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  int width = 0;
-  int height = 0;
-
-  Eigen::Vector3d Center() const { return -R.transpose() * t; }
-  // The same camera for an image of width x height covering the same extent (a resized image).
-  StereoCamera Scaled(int new_width, int new_height) const;
-  // The camera of level `level` of the 2 x 2 box pyramid (DownsampleHalf in
-  // src/orientation/orientation_field.h): image coordinates halve exactly at every level and the
-  // size is ceil(size / 2^level). Not Scaled(ceil(W / 2^level), ...): for an odd size the last
-  // pixel of a level reaches beyond the image, so the level does not cover the same extent.
-  StereoCamera PyramidLevel(int level) const;
-};
 
 // u = D * H * (x, y, 1) + b maps the reference image point (x, y) at z-depth D to homogeneous
 // image coordinates of the source (both on the grids their cameras are for).

@@ -298,7 +298,9 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
   const Reconstruction imported = ReadReconstruction(JoinPaths(out, "sparse"));
   for (const auto& [id, image] : imported.images) {
-    if (image.name == "v1.png") EXPECT_LT((image.ProjectionCenter() - true_centre).norm(), 1e-12);
+    if (image.name == "v1.png") {
+      EXPECT_LT((image.ProjectionCenter() - true_centre).norm(), 1e-12);
+    }
   }
   DepthEvaluationOptions options = FastDepthOptions();
   options.image_names = {"v1.png"};
@@ -397,7 +399,9 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   const std::string kept = JoinPaths(scene.dir, "kept_poses");
   ImportGroundTruth(scene.gt, scene.workspace, kept, ImportGroundTruthOptions());
   for (const auto& [id, image] : ReadReconstruction(JoinPaths(kept, "sparse")).images) {
-    if (image.name == "v1.png") EXPECT_LT((image.ProjectionCenter() - centre).norm(), 1e-12);
+    if (image.name == "v1.png") {
+      EXPECT_LT((image.ProjectionCenter() - centre).norm(), 1e-12);
+    }
   }
 }
 
