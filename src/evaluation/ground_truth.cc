@@ -25,13 +25,11 @@ void RequireShape(const NpyArray& array, const std::vector<size_t>& shape,
            what << ": expected shape " << text(shape) << ", found " << text(array.shape));
 }
 
-// A wrong folder (--ground_truth_path, synthesize's --strands_path) is named as such, not as
-// the first file missing from it.
+}  // namespace
+
 void RequireGroundTruthDir(const std::string& gt_path) {
   RequireDir(gt_path, "ground truth folder (a data set's gt/)");
 }
-
-}  // namespace
 
 std::string GroundTruthViewPath(const std::string& gt_path, const std::string& image_name) {
   std::string stem = image_name;

@@ -29,6 +29,10 @@ struct GroundTruthView {
 // gt_path/<stem of image_name>.npz ("g0_c.png" -> gt_path/g0_c.npz). Throws hairmvs::Error
 // naming the file when it is missing or its arrays are not H x W float32 / uint8.
 std::string GroundTruthViewPath(const std::string& gt_path, const std::string& image_name);
+// Throws hairmvs::Error "Missing ground truth folder (a data set's gt/): gt_path" unless it is a
+// folder. The readers below check it first, so that a wrong --ground_truth_path (or
+// synthesize's --strands_path) is named as such, not as the first file missing from it.
+void RequireGroundTruthDir(const std::string& gt_path);
 // gt_path/cameras.npz.
 std::string GroundTruthCamerasPath(const std::string& gt_path);
 GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::string& image_name);

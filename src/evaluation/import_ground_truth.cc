@@ -130,7 +130,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   std::string error;
   THROW_IF(!options.Check(&error), error);
   THROW_IF(output_path.empty(), "Empty --output_path");
-  RequireDir(ground_truth_path, "ground truth folder (--ground_truth_path)");
+  RequireGroundTruthDir(ground_truth_path);  // before anything is written
   THROW_IF(IsSameOrInside(output_path, workspace_path),
            "--output_path " << output_path << " is inside the workspace " << workspace_path
                             << ": import_ground_truth writes a new workspace");
