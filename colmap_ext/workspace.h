@@ -37,6 +37,8 @@ class Workspace {
   // The camera of image `name` (its intrinsics and pose) on its image's pixel grid; Scaled()
   // carries it to a smaller map's (COLMAP's max_image_size, a coarse grid).
   StereoCamera ViewCamera(const std::string& name) const;
+  // The masks folder (`mask_path`, or `path`/masks); "" when the workspace has none.
+  const std::string& MaskFolder() const { return mask_path_; }
   // "" when the workspace has no masks or this image has none.
   std::string MaskPath(const std::string& name) const;
   // With a masks folder, the images that have no mask in it (Read warns about them).

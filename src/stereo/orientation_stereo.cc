@@ -432,9 +432,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
-  if (workspace.ImagesWithoutMask().empty() &&
-      std::all_of(names.begin(), names.end(),
-                  [&](const std::string& name) { return workspace.MaskPath(name).empty(); })) {
+  if (workspace.MaskFolder().empty()) {
     LOG(WARNING) << JoinPaths(workspace_path, "masks")
                  << " does not exist: every pixel is matched, the background too, and each "
                     "depth range comes from all of the view's sparse points. With hair masks "
