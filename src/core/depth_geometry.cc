@@ -40,12 +40,15 @@ StereoCamera StereoCamera::PyramidLevel(int level) const {
   return scaled;
 }
 
-Eigen::Vector3d StereoCamera::BackProject(int col, int row, double depth) const {
+Eigen::Vector3d BackProjectPixelToWorld(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
+                                        const Eigen::Vector3d& t, double col, double row,
+                                        double depth) {
   return R.transpose() * (BackProjectPixel(K, col, row, depth) - t);
 }
 
-bool StereoCamera::Project(const Eigen::Vector3d& world, int* col, int* row,
-                           double* depth) const {
+bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                    int width, int height, const Eigen::Vector3d& world, int* col, int* row,
+                    double* depth) {
   const Eigen::Vector3d x = K * (R * world + t);
   if (!(x.z() > 0)) return false;
   const double c = std::floor(x.x() / x.z()), r = std::floor(x.y() / x.z());
@@ -54,6 +57,15 @@ bool StereoCamera::Project(const Eigen::Vector3d& world, int* col, int* row,
   *row = static_cast<int>(r);
   *depth = x.z();
   return true;
+}
+
+Eigen::Vector3d StereoCamera::BackProject(int col, int row, double depth) const {
+  return BackProjectPixelToWorld(K, R, t, col, row, depth);
+}
+
+bool StereoCamera::Project(const Eigen::Vector3d& world, int* col, int* row,
+                           double* depth) const {
+  return ProjectToPixel(K, R, t, width, height, world, col, row, depth);
 }
 
 FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,

@@ -13,6 +13,19 @@ namespace hairmvs {
 // depth * K^-1 * (col + 0.5, row + 0.5, 1).
 Eigen::Vector3d BackProjectPixel(const Eigen::Matrix3d& K, double col, double row, double depth);
 
+// The world point that the camera X_cam = R X_world + t sees at pixel (col, row) with z-depth
+// `depth`: R^T (BackProjectPixel(K, col, row, depth) - t).
+Eigen::Vector3d BackProjectPixelToWorld(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
+                                        const Eigen::Vector3d& t, double col, double row,
+                                        double depth);
+
+// The pixel of a width x height grid that a world point lands in, seen by the camera
+// X_cam = R X_world + t (pixel (col, row) covers [col, col + 1) x [row, row + 1)), and its
+// z-depth; false when it is behind the camera or off the grid.
+bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                    int width, int height, const Eigen::Vector3d& world, int* col, int* row,
+                    double* depth);
+
 // A pinhole camera on a width x height pixel grid: X_cam = R X_world + t. The stereo's cameras
 // at the processing resolution and its pyramid levels, the evaluators' workspace and true
 // cameras (ViewCamera in colmap_ext/workspace.h builds a view's).

@@ -124,7 +124,6 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
     THROW_IF(i < 0, "Image " << name << " has no camera in "
                              << GroundTruthCamerasPath(ground_truth_path));
     const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
-    const Eigen::Matrix3d Rt = cameras.R[i].transpose();
     for (int r = 0; r < view.depth.Height(); ++r) {
       for (int c = 0; c < view.depth.Width(); ++c) {
         const float d = view.depth.At(r, c);
@@ -132,7 +131,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
           continue;
         }
         surface.push_back(
-            (Rt * (BackProjectPixel(cameras.K, c, r, d) - cameras.t[i])).cast<float>());
+            BackProjectPixelToWorld(cameras.K, cameras.R[i], cameras.t[i], c, r, d).cast<float>());
       }
     }
   }

@@ -40,14 +40,13 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
   for (int v = 0; v < static_cast<int>(views.size()); ++v) {
     const FusionView& view = views[v];
     CHECK_EQ(view.normal.Channels(), 3) << view.name << ": normals are needed";
-    const Eigen::Matrix3d Rt = view.R.transpose();
     FusionPoints& out = per_view[v];
     for (int row = 0; row < view.depth.Height(); row += stride) {
       for (int col = 0; col < view.depth.Width(); col += stride) {
         const float depth = view.depth.At(row, col);
         if (!(depth > 0)) continue;
         ++num_taken[v];
-        const Eigen::Vector3d world = Rt * (BackProjectPixel(view.K, col, row, depth) - view.t);
+        const Eigen::Vector3d world = view.BackProject(col, row, depth);
         Eigen::Vector3d normal = view.WorldNormalAt(row, col);
         if (normal.squaredNorm() < 0.5) continue;  // no normal where the depth is isolated
         std::vector<uint32_t> visible;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "src/core/depth_geometry.h"
 #include "src/core/float_map.h"
 
 namespace hairmvs {
@@ -26,15 +27,11 @@ struct FusionView {
   // Projects a world point into the pixel grid (SfM convention: pixel (col,row) covers
   // [col, col+1) x [row, row+1)). Returns false behind the camera or outside the map.
   bool Project(const Eigen::Vector3d& world, int* col, int* row, double* z) const {
-    const Eigen::Vector3d cam = R * world + t;
-    if (cam.z() <= 0) return false;
-    const Eigen::Vector3d uv = K * cam;
-    const double u = uv.x() / uv.z(), v = uv.y() / uv.z();
-    if (!(u >= 0 && v >= 0 && u < depth.Width() && v < depth.Height())) return false;
-    *col = static_cast<int>(u);
-    *row = static_cast<int>(v);
-    *z = cam.z();
-    return true;
+    return ProjectToPixel(K, R, t, depth.Width(), depth.Height(), world, col, row, z);
+  }
+  // The world point this map's camera sees at pixel (col, row) with z-depth `z`.
+  Eigen::Vector3d BackProject(int col, int row, double z) const {
+    return BackProjectPixelToWorld(K, R, t, col, row, z);
   }
   // The point of this map's surface on the line of sight through `world` (the depth of the
   // pixel it projects to, along its own ray): how the map "sees" that point.

@@ -27,7 +27,6 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
                                      double max_reprojection_error_px, int min_consistent_views,
                                      ConsistencyFilterStats* stats) {
   FloatMap filtered = ref.depth;
-  const Eigen::Matrix3d R_t = ref.R.transpose();
   const int width = ref.depth.Width(), height = ref.depth.Height();
   int num_checked = 0, num_kept = 0;
 #pragma omp parallel for schedule(dynamic, 8) reduction(+ : num_checked, num_kept)
@@ -36,7 +35,7 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
       const float depth = ref.depth.At(row, col);
       if (!(depth > 0)) continue;
       ++num_checked;
-      const Eigen::Vector3d world = R_t * (BackProjectPixel(ref.K, col, row, depth) - ref.t);
+      const Eigen::Vector3d world = ref.BackProject(col, row, depth);
       const Eigen::Vector2d centre(col + 0.5, row + 0.5);
       int consistent = 0;
       for (const FusionView* other : others) {

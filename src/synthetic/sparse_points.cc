@@ -56,8 +56,7 @@ Reconstruction MakeSparseModel(const std::vector<SyntheticView>& views,
     for (int64_t p : chosen) {
       const int row = static_cast<int>(p / W), col = static_cast<int>(p % W);
       const double depth = ri.depth.At(row, col);
-      const Eigen::Vector3d x_world =
-          vi.R.transpose() * (BackProjectPixel(vi.K, col, row, depth) - vi.t);
+      const Eigen::Vector3d x_world = BackProjectPixelToWorld(vi.K, vi.R, vi.t, col, row, depth);
       struct Obs {
         size_t view;
         Eigen::Vector2d xy;
