@@ -173,6 +173,23 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   std::filesystem::remove_all(path);
 }
 
+TEST(OrientationStereoWorkspace, DistortedCameraIsNamedBeforeAnyWork) {
+  // A sparse model instead of image_undistorter's: a SIMPLE_RADIAL camera.
+  const std::string path = MakeTestDir("stereo_distorted");
+  WriteWorkspace(path);
+  Reconstruction model = ReadReconstruction(JoinPaths(path, "sparse"));
+  model.cameras.at(1).model_id = 2;  // SIMPLE_RADIAL: f, cx, cy, k
+  model.cameras.at(1).params = {100, 48, 36, 0.01};
+  WriteReconstruction(model, JoinPaths(path, "sparse"), ModelFormat::kText);
+  const std::string error =
+      ErrorOf([&] { RunOrientationStereo(path, {"v0.png"}, PlaneOptions(), nullptr); });
+  EXPECT_NE(error.find("SIMPLE_RADIAL"), std::string::npos) << error;
+  EXPECT_NE(error.find("image_undistorter"), std::string::npos) << error;
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_FALSE(ExistsFile(Workspace::Read(path).DepthMapPath("v0.png")));
+  std::filesystem::remove_all(path);
+}
+
 TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   const std::string root = MakeTestDir("stereo_fields");
   const std::string stereo_path = JoinPaths(root, "stereo"), fields_path = JoinPaths(root, "f");
