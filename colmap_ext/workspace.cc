@@ -88,6 +88,10 @@ const Camera& Workspace::CameraOf(const std::string& name) const {
   return camera;
 }
 
+void Workspace::RequireUndistortedCameras() const {
+  for (const std::string& name : image_names_) CameraOf(name);
+}
+
 std::string Workspace::ImagePath(const std::string& name) const {
   return JoinPaths(path_, "images", name);
 }

@@ -32,6 +32,9 @@ class Workspace {
   const Image& ImageByName(const std::string& name) const;
   // Throws (telling the user to run colmap image_undistorter) unless PINHOLE/SIMPLE_PINHOLE.
   const Camera& CameraOf(const std::string& name) const;
+  // Throws, as CameraOf does, unless every image's camera is PINHOLE or SIMPLE_PINHOLE: what
+  // the dense stage needs of all the views (any can be a source), checked before any work.
+  void RequireUndistortedCameras() const;
 
   std::string ImagePath(const std::string& name) const;
   // The camera of image `name` (its intrinsics and pose) on its image's pixel grid; Scaled()

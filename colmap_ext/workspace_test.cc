@@ -30,6 +30,7 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_THROW(ws.ImageIdx("d.png"), Error);
   EXPECT_EQ(ws.ImageByName("b.png").image_id, 2u);
   EXPECT_EQ(ws.CameraOf("b.png").CalibrationMatrix()(0, 0), 50.0);
+  EXPECT_NO_THROW(ws.RequireUndistortedCameras());
   EXPECT_EQ(ws.ImagePath("a.png"), JoinPaths(dir, "images", "a.png"));
   EXPECT_EQ(ws.DepthMapPath("a.png"),
             JoinPaths(dir, "stereo", "depth_maps", "a.png.geometric.bin"));
@@ -82,6 +83,8 @@ TEST(Workspace, BadWorkspaces) {
   WriteTestWorkspace(distorted, model, true);
   const Workspace ws = Workspace::Read(distorted);
   EXPECT_NE(ErrorOf([&] { ws.CameraOf("a.png"); }).find("image_undistorter"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ws.RequireUndistortedCameras(); }).find("SIMPLE_RADIAL"),
+            std::string::npos);
 }
 
 TEST(Images, GrayRgbAndSixteenBit) {

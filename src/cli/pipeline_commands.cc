@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "colmap_ext/source_views.h"
+#include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
 #include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
@@ -118,6 +119,11 @@ int RunPipeline(int argc, char** argv) {
                                                 "create it with colmap image_undistorter");
     ScopedStageTimer timer(&timings, "image_undistorter");
     RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
+  }
+
+  if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {
+    // Before the orientation fields' minutes, not after them.
+    Workspace::Read(workspace_path).RequireUndistortedCameras();
   }
 
   const int num_stages = static_cast<int>(stages.size());

@@ -430,9 +430,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   const Workspace workspace = Workspace::Read(workspace_path);
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
-  // Any view can be a source: every camera must be undistorted, which CameraOf says (naming the
-  // image and the workspace) before the source selection meets the first one that is not.
-  for (const std::string& name : workspace.ImageNames()) workspace.CameraOf(name);
+  workspace.RequireUndistortedCameras();
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
   if (workspace.MaskFolder().empty()) {
