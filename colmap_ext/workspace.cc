@@ -92,6 +92,35 @@ void Workspace::RequireUndistortedCameras() const {
   for (const std::string& name : image_names_) CameraOf(name);
 }
 
+namespace {
+
+void RequireCameraSize(const FloatMap& image, const std::string& path, const Camera& camera) {
+  THROW_IF(image.Width() != static_cast<int>(camera.width) ||
+               image.Height() != static_cast<int>(camera.height),
+           "Image " << path << " is " << image.Width() << " x " << image.Height()
+                    << " but its camera " << camera.camera_id << " is " << camera.width << " x "
+                    << camera.height
+                    << ": images/ must be as colmap image_undistorter wrote them (the stereo's "
+                       "--OrientationStereo.max_image_size works at a lower resolution without "
+                       "resizing them)");
+}
+
+}  // namespace
+
+FloatMap Workspace::ReadViewGray(const std::string& name) const {
+  const std::string path = ImagePath(name);
+  FloatMap image = ReadImageGray(path);
+  RequireCameraSize(image, path, model_.cameras.at(ImageByName(name).camera_id));
+  return image;
+}
+
+FloatMap Workspace::ReadViewRgb(const std::string& name) const {
+  const std::string path = ImagePath(name);
+  FloatMap image = ReadImageRgb(path);
+  RequireCameraSize(image, path, model_.cameras.at(ImageByName(name).camera_id));
+  return image;
+}
+
 std::string Workspace::ImagePath(const std::string& name) const {
   return JoinPaths(path_, "images", name);
 }

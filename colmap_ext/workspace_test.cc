@@ -31,6 +31,16 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_EQ(ws.ImageByName("b.png").image_id, 2u);
   EXPECT_EQ(ws.CameraOf("b.png").CalibrationMatrix()(0, 0), 50.0);
   EXPECT_NO_THROW(ws.RequireUndistortedCameras());
+  const FloatMap gray = ws.ReadViewGray("a.png");
+  EXPECT_EQ(gray.Width(), 64);
+  EXPECT_EQ(ws.ReadViewRgb("a.png").Channels(), 3);
+  // An image resized after the undistorter no longer fits its camera: named, with both sizes.
+  cv::imwrite(JoinPaths(dir, "images", "c.png"), cv::Mat(24, 32, CV_8U, cv::Scalar(128)));
+  const std::string resized = ErrorOf([&] { ws.ReadViewGray("c.png"); });
+  EXPECT_NE(resized.find(JoinPaths(dir, "images", "c.png") + " is 32 x 24"), std::string::npos)
+      << resized;
+  EXPECT_NE(resized.find("is 64 x 48"), std::string::npos) << resized;
+  EXPECT_NE(ErrorOf([&] { ws.ReadViewRgb("c.png"); }).find("is 32 x 24"), std::string::npos);
   EXPECT_EQ(ws.ImagePath("a.png"), JoinPaths(dir, "images", "a.png"));
   EXPECT_EQ(ws.DepthMapPath("a.png"),
             JoinPaths(dir, "stereo", "depth_maps", "a.png.geometric.bin"));

@@ -220,7 +220,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       } else {
         view.normal = NormalMapFromDepthMap(view.depth, view.K);
       }
-      view.rgb = ResizeNearest(ReadImageRgb(workspace.ImagePath(name)), view.depth.Width(),
+      view.rgb = ResizeNearest(workspace.ReadViewRgb(name), view.depth.Width(),
                                view.depth.Height());
       views.push_back(std::move(view));
       image_idx_of_view.push_back(static_cast<uint32_t>(idx));

@@ -99,7 +99,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     FloatMap gray, mask;
     {
       ScopedStageTimer timer(timings, "read image");
-      gray = ReadImageGray(workspace.ImagePath(name));
+      gray = workspace.ReadViewGray(name);
       const std::string mask_path = workspace.MaskPath(name);
       if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
     }

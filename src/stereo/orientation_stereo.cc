@@ -357,7 +357,7 @@ class ViewLoader {
     FloatMap gray;
     if (!reused) {
       data.orientation.clear();
-      gray = ResizeArea(ReadImageGray(workspace_.ImagePath(name)), w, h);
+      gray = ResizeArea(workspace_.ReadViewGray(name), w, h);
       const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
         OrientationFieldOptions field_options = field_options_;
@@ -379,7 +379,7 @@ class ViewLoader {
       }
     }
     if (options_.MatchesColour()) {
-      data.rgb.push_back(ResizeArea(ReadImageRgb(workspace_.ImagePath(name)), w, h));
+      data.rgb.push_back(ResizeArea(workspace_.ReadViewRgb(name), w, h));
       for (int l = 1; l < options_.PyramidLevels(); ++l) {
         data.rgb.push_back(DownsampleHalf(data.rgb.back()));
       }
