@@ -101,6 +101,7 @@ void WriteJsonSummary(const std::string& path, const nlohmann::json& json) {
 
 GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_cameras) {
   if (!in_true_cameras) return GroundTruthCameras();
+  RequireGroundTruthDir(gt_path);  // a wrong folder is named as such, not as its missing file
   const std::string path = GroundTruthCamerasPath(gt_path);
   THROW_IF(!ExistsFile(path),
            "Missing " << path << ": the true cameras, in which each depth is compared with the "

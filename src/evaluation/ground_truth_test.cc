@@ -11,6 +11,7 @@
 
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/evaluation/evaluation_util.h"
 
 namespace hairmvs {
 namespace {
@@ -98,7 +99,8 @@ TEST(GroundTruth, MissingFolderIsNamedAsTheGroundTruth) {
   const std::vector<std::function<void()>> readers = {
       [&] { ReadGroundTruthView(missing, "v0.png"); },
       [&] { ReadGroundTruthCameras(missing); },
-      [&] { ReadGroundTruthStrands(missing); }};
+      [&] { ReadGroundTruthStrands(missing); },
+      [&] { ReadTrueCameras(missing, true); }};  // the evaluators' own check of cameras.npz
   for (const auto& read : readers) {
     try {
       read();
