@@ -203,12 +203,13 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
     DataTermSamples samples;
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
+    const StereoCamera view_camera = ws.ViewCamera(name);
     const StereoCamera truth_camera =
         options.in_true_cameras
             ? TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
-            : ws.ViewCamera(name).Scaled(gt_width, gt_height);
+            : view_camera.Scaled(gt_width, gt_height);
     EvaluateView(volume, gt, truth_camera,
-                 ws.ViewCamera(name).Scaled(volume.cost.Width(), volume.cost.Height()),
+                 view_camera.Scaled(volume.cost.Width(), volume.cost.Height()),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);

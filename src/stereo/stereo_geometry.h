@@ -14,7 +14,6 @@
 
 namespace hairmvs {
 
-
 // u = D * H * (x, y, 1) + b maps the reference image point (x, y) at z-depth D to homogeneous
 // image coordinates of the source (both on the grids their cameras are for).
 struct ViewProjection {

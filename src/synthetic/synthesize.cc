@@ -35,7 +35,6 @@ std::string Stem(const std::string& name) {
   return dot == std::string::npos ? name : name.substr(0, dot);
 }
 
-
 cv::Mat RgbToBgrMat(const std::vector<uint8_t>& rgb, int width, int height) {
   cv::Mat mat(height, width, CV_8UC3);
   for (int r = 0; r < height; ++r) {
@@ -220,9 +219,10 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
     gt.depth = r.depth;
     gt.label = r.label;
     WriteGroundTruthView(gt_path, views[v].name, gt);
-    WriteImage(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_depth.png"), DepthPicture(r.depth));
+    WriteImage(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_depth.png"),
+               DepthPicture(r.depth));
     WriteImage(JoinPaths(gt_path, "vis", Stem(views[v].name) + "_label.png"),
-             LabelPicture(r.label, W, H));
+               LabelPicture(r.label, W, H));
     result.seconds_write += timer.ElapsedSeconds();
   }
   progress.Finish();
