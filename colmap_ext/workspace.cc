@@ -92,9 +92,9 @@ void Workspace::RequireUndistortedCameras() const {
   for (const std::string& name : image_names_) CameraOf(name);
 }
 
-namespace {
-
-void RequireCameraSize(const FloatMap& image, const std::string& path, const Camera& camera) {
+FloatMap Workspace::RequireCameraSize(const std::string& name, FloatMap image) const {
+  const std::string path = ImagePath(name);
+  const Camera& camera = model_.cameras.at(ImageByName(name).camera_id);
   THROW_IF(image.Width() != static_cast<int>(camera.width) ||
                image.Height() != static_cast<int>(camera.height),
            "Image " << path << " is " << image.Width() << " x " << image.Height()
@@ -103,22 +103,15 @@ void RequireCameraSize(const FloatMap& image, const std::string& path, const Cam
                     << ": images/ must be as colmap image_undistorter wrote them (the stereo's "
                        "--OrientationStereo.max_image_size works at a lower resolution without "
                        "resizing them)");
+  return image;
 }
 
-}  // namespace
-
 FloatMap Workspace::ReadViewGray(const std::string& name) const {
-  const std::string path = ImagePath(name);
-  FloatMap image = ReadImageGray(path);
-  RequireCameraSize(image, path, model_.cameras.at(ImageByName(name).camera_id));
-  return image;
+  return RequireCameraSize(name, ReadImageGray(ImagePath(name)));
 }
 
 FloatMap Workspace::ReadViewRgb(const std::string& name) const {
-  const std::string path = ImagePath(name);
-  FloatMap image = ReadImageRgb(path);
-  RequireCameraSize(image, path, model_.cameras.at(ImageByName(name).camera_id));
-  return image;
+  return RequireCameraSize(name, ReadImageRgb(ImagePath(name)));
 }
 
 std::string Workspace::ImagePath(const std::string& name) const {

@@ -62,6 +62,9 @@ class Workspace {
   std::string OrientationMapPath(const std::string& name, int level) const;
 
  private:
+  // `image` (read from ImagePath(name)), or throws naming it unless it has its camera's size.
+  FloatMap RequireCameraSize(const std::string& name, FloatMap image) const;
+
   std::string path_;
   std::string mask_path_;
   Reconstruction model_;
