@@ -7,6 +7,7 @@
 #include <iterator>
 #include <set>
 
+#include "colmap_ext/test_util.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
 #include "src/core/npz.h"
@@ -185,14 +186,9 @@ TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
             ReadBytes(JoinPaths(second_path, "dense", "images", "g0_c.png")));
 
   options.strands_path = JoinPaths(first_path, "no_such_folder");
-  try {
-    RunSynthesize(options);
-    ADD_FAILURE() << "no error for a missing strands folder";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
-    EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
-  }
+  const std::string message = testing_util::ErrorOf([&] { RunSynthesize(options); });
+  EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
+  EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
 }
 
 TEST(Synthesize, DeterministicForASeed) {
