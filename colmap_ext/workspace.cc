@@ -176,6 +176,10 @@ std::string Workspace::OrientationMapPath(const std::string& name, int level) co
                    name + ".l" + std::to_string(level) + ".bin");
 }
 
+std::string Workspace::OrientationMapProvenancePath(const std::string& name) const {
+  return JoinPaths(StereoPath(), "orientation_maps", name + ".provenance.txt");
+}
+
 // ---------------------------------------------------------------------------------------------
 // Images.
 

@@ -60,6 +60,8 @@ class Workspace {
   std::string CostVolumePath(const std::string& name) const;
   std::string CostVolumeDepthsPath(const std::string& name) const;
   std::string OrientationMapPath(const std::string& name, int level) const;
+  // What the cached levels of `name` were computed from (src/orientation/orientation_maps.h).
+  std::string OrientationMapProvenancePath(const std::string& name) const;
 
  private:
   // `image` (read from ImagePath(name)), or throws naming it unless it has its camera's size.

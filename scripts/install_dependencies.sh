@@ -12,7 +12,7 @@ PACKAGES=(
   libmaxflow-dev
   libcgal-dev libgmp-dev libmpfr-dev
   libboost-program-options-dev libboost-filesystem-dev
-  nlohmann-json3-dev libzip-dev libnanoflann-dev
+  nlohmann-json3-dev libzip-dev zlib1g-dev libnanoflann-dev
   libopen3d-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )

@@ -122,7 +122,8 @@ struct OrientationFieldsResult {
 };
 
 // Writes W/stereo/orientation_maps/<image name>.l<k>.bin (2-channel Mat: Re O, Im O) for
-// every level k. Adds the per-stage times to `timings` (may be null).
+// every level k, and <image name>.provenance.txt: what they were computed from, so that the
+// stereo reuses them only while that holds (src/orientation/orientation_maps.h). Adds the per-stage times to `timings` (may be null).
 OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
                                              const OrientationFieldOptions& options,
                                              const OrientationFieldsRunOptions& run_options,

@@ -394,7 +394,10 @@ struct OrientationStereoOptions {
   int coarse_volume_cache_mib = 2048;
   // Only the geometric pass, on the existing .photometric maps.
   bool geom_consistency_only = false;
-  // Reuse / write stereo/orientation_maps/<name>.l<k>.bin.
+  // Reuse / write stereo/orientation_maps/<name>.l<k>.bin. Cached fields are reused only while
+  // their <name>.provenance.txt matches the image, the mask, the processing size and the
+  // --OrientationField options in use; otherwise they are computed again (and the log says
+  // which of these changed).
   bool reuse_orientation_maps = true;
   bool write_orientation_maps = true;
   bool write_png = false;
@@ -495,7 +498,7 @@ struct OrientationStereoOptions {
     v("geom_consistency_only", &geom_consistency_only,
       "only the geometric pass (prior and filter), on the existing .photometric maps");
     v("reuse_orientation_maps", &reuse_orientation_maps,
-      "read stereo/orientation_maps/*.l<k>.bin when present and of the right size");
+      "reuse stereo/orientation_maps/*.l<k>.bin made from this image, mask, size and filter");
     v("write_orientation_maps", &write_orientation_maps,
       "write computed orientation fields to stereo/orientation_maps/");
     v("write_png", &write_png, "also write coloured depth and normal pictures (PNG)");
@@ -536,7 +539,8 @@ struct OrientationStereoResult {
 // `source_views` chooses the source views (null: SourceViewOptions' defaults, 4 views); an
 // explicit patch-match.cfg list is capped to its max_num_source_views. `field_options` (null:
 // the defaults, the paper's filter) computes the orientation fields that are not cached in
-// stereo/orientation_maps/ (its num_levels is replaced by options.PyramidLevels()).
+// stereo/orientation_maps/ with these options (its num_levels is replaced by
+// options.PyramidLevels()).
 // Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const std::vector<std::string>& image_names,

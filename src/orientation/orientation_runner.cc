@@ -15,6 +15,7 @@
 #include "src/core/progress.h"
 #include "src/opencl/opencl_context.h"
 #include "src/orientation/orientation_field.h"
+#include "src/orientation/orientation_maps.h"
 
 namespace hairmvs {
 namespace {
@@ -107,12 +108,14 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     const std::vector<FloatMap> levels = computer->Compute(gray, mask);
     progress.Stage("write");
     ScopedStageTimer timer(timings, "write");
-    for (int l = 0; l < static_cast<int>(levels.size()); ++l) {
-      const std::string path = workspace.OrientationMapPath(name, l);
-      WriteMat(path, levels[l]);
-      ++result.num_files_written;
-      if (run_options.write_png) {
-        WriteOrientationPng(PngPathFor(path), levels[l]);
+    WriteOrientationFields(
+        workspace, name,
+        OrientationFieldsProvenance(workspace, name, gray.Width(), gray.Height(), options),
+        levels);
+    result.num_files_written += static_cast<int>(levels.size()) + 1;
+    if (run_options.write_png) {
+      for (int l = 0; l < static_cast<int>(levels.size()); ++l) {
+        WriteOrientationPng(PngPathFor(workspace.OrientationMapPath(name, l)), levels[l]);
         ++result.num_files_written;
       }
     }

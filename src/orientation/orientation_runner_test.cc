@@ -1,4 +1,5 @@
-// RunOrientationFields on a small workspace written to a temporary folder.
+// RunOrientationFields on a small workspace written to a temporary folder, and the reuse of the
+// fields it caches (orientation_maps.h).
 
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -8,6 +9,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "colmap_ext/mat_io.h"
@@ -18,6 +21,7 @@
 #include "src/core/logging.h"
 #include "src/opencl/opencl_context.h"
 #include "src/orientation/orientation_field.h"
+#include "src/orientation/orientation_maps.h"
 
 namespace hairmvs {
 namespace {
@@ -75,7 +79,7 @@ TEST(RunOrientationFields, WritesEveryLevelOfEveryImage) {
   StageTimings timings;
   const OrientationFieldsResult result = RunOrientationFields(root, options, run_options, &timings);
   EXPECT_EQ(result.num_images, 2);
-  EXPECT_EQ(result.num_files_written, 12);
+  EXPECT_EQ(result.num_files_written, 14);  // 3 levels, 3 pictures and the provenance each
   EXPECT_GT(timings.Get("filter kernel"), 0);
   const Workspace workspace = Workspace::Read(root);
   OrientationFieldComputer computer(OpenCLContext::Create(), options);
@@ -136,6 +140,83 @@ TEST(RunOrientationFields, ImageSubsetAndErrors) {
   bad.num_levels = 0;
   run_options.opencl_device = "";
   EXPECT_THROW(RunOrientationFields(root, bad, run_options, nullptr), Error);
+  std::system(("rm -rf " + root).c_str());
+}
+
+// The cached fields are reused while the image, the mask, the size and the filter options they
+// were computed from still hold, and only then; each miss says why.
+TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
+  const std::string root = MakeWorkspace();
+  RunOrientationFields(root, OrientationFieldOptions(), OrientationFieldsRunOptions(), nullptr);
+  const Workspace workspace = Workspace::Read(root);
+  const std::vector<std::array<int, 2>> sizes = {{80, 60}, {40, 30}, {20, 15}};
+  auto read = [&](const std::string& name, const OrientationFieldOptions& options,
+                  std::string* why_not, int width = kWidth, int height = kHeight) {
+    return ReadCachedOrientationFields(
+        workspace, name, OrientationFieldsProvenance(workspace, name, width, height, options),
+        sizes, why_not);
+  };
+  std::string why_not;
+  OrientationFieldOptions options;
+  auto cached = read("a.png", options, &why_not);
+  ASSERT_TRUE(cached.has_value()) << why_not;
+  EXPECT_EQ(why_not, "");
+  ASSERT_EQ(cached->size(), 3u);
+  for (int l = 0; l < 3; ++l) {
+    EXPECT_EQ((*cached)[l].Data(), ReadMat(workspace.OrientationMapPath("a.png", l)).Data());
+  }
+  // Level k does not depend on how many levels are computed.
+  options.num_levels = 1;
+  EXPECT_TRUE(read("a.png", options, &why_not).has_value()) << why_not;
+
+  // Another filter option, another size.
+  options.dark_strands = false;
+  EXPECT_FALSE(read("a.png", options, &why_not).has_value());
+  EXPECT_NE(why_not.find("a.png.provenance.txt says `OrientationField.dark_strands = 1`, now "
+                         "`OrientationField.dark_strands = 0`"),
+            std::string::npos)
+      << why_not;
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not, 40, 30).has_value());
+  EXPECT_NE(why_not.find("says `size 80 x 60`, now `size 40 x 30`"), std::string::npos)
+      << why_not;
+
+  // A replaced mask, a replaced image.
+  cv::Mat mask(kHeight, kWidth, CV_8UC1, cv::Scalar(255));
+  mask.colRange(0, 30).setTo(0);
+  CHECK(cv::imwrite(workspace.MaskPath("b.png"), mask));
+  EXPECT_FALSE(read("b.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("says `mask "), std::string::npos) << why_not;
+  CHECK(cv::imwrite(workspace.ImagePath("a.png"), cv::Mat(kHeight, kWidth, CV_8UC1,
+                                                          cv::Scalar(7))));
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("says `image "), std::string::npos) << why_not;
+
+  // Writing replaces the provenance with the new one; a truncated or missing level is a miss.
+  const std::string provenance =
+      OrientationFieldsProvenance(workspace, "a.png", kWidth, kHeight, OrientationFieldOptions());
+  OrientationFieldComputer computer(OpenCLContext::Create(), OrientationFieldOptions());
+  WriteOrientationFields(workspace, "a.png", provenance,
+                         computer.Compute(ReadImageGray(workspace.ImagePath("a.png")), FloatMap()));
+  EXPECT_EQ(ReadTextFile(workspace.OrientationMapProvenancePath("a.png")), provenance);
+  EXPECT_TRUE(read("a.png", OrientationFieldOptions(), &why_not).has_value()) << why_not;
+  std::filesystem::resize_file(workspace.OrientationMapPath("a.png", 1), 100);
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("cannot be read"), std::string::npos) << why_not;
+  std::filesystem::remove(workspace.OrientationMapPath("a.png", 2));
+  std::filesystem::remove(workspace.OrientationMapPath("a.png", 1));
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("stop before level 1"), std::string::npos) << why_not;
+
+  // Levels without a provenance (an older hairmvs) are a miss that says so; nothing cached at
+  // all is a miss without a word.
+  std::filesystem::remove(workspace.OrientationMapProvenancePath("a.png"));
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("have no " + workspace.OrientationMapProvenancePath("a.png")),
+            std::string::npos)
+      << why_not;
+  std::filesystem::remove(workspace.OrientationMapPath("a.png", 0));
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_EQ(why_not, "");
   std::system(("rm -rf " + root).c_str());
 }
 

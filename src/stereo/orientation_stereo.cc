@@ -27,6 +27,7 @@
 #include "src/mrf/mrf.h"
 #include "src/opencl/opencl_context.h"
 #include "src/orientation/orientation_field.h"
+#include "src/orientation/orientation_maps.h"
 #include "src/stereo/depth_estimator.h"
 #include "src/stereo/consistency_filter.h"
 #include "src/stereo/depth_range.h"
@@ -339,36 +340,30 @@ class ViewLoader {
       const StereoCamera level = data.camera.PyramidLevel(l);
       sizes.push_back({level.width, level.height});
     }
-    bool reused = options_.reuse_orientation_maps;
-    for (int l = 0; l < options_.PyramidLevels() && reused; ++l) {
-      const std::string path = workspace_.OrientationMapPath(name, l);
-      if (!ExistsFile(path)) {
-        reused = false;
-        break;
-      }
-      FloatMap level = ReadMat(path);
-      if (level.Width() != sizes[l][0] || level.Height() != sizes[l][1] ||
-          level.Channels() != 2) {
-        reused = false;
-        break;
-      }
-      data.orientation.push_back(std::move(level));
+    // The fields are those of the filter options in use at this size, whatever computed them.
+    OrientationFieldOptions field_options = field_options_;
+    field_options.num_levels = options_.PyramidLevels();
+    std::string provenance;
+    if (options_.reuse_orientation_maps || options_.write_orientation_maps) {
+      provenance = OrientationFieldsProvenance(workspace_, name, w, h, field_options);
     }
-    FloatMap gray;
-    if (!reused) {
-      data.orientation.clear();
-      gray = ResizeArea(workspace_.ReadViewGray(name), w, h);
+    std::optional<std::vector<FloatMap>> cached;
+    if (options_.reuse_orientation_maps) {
+      std::string why_not;
+      cached = ReadCachedOrientationFields(workspace_, name, provenance, sizes, &why_not);
+      if (!why_not.empty()) LOG(INFO) << name << ": " << why_not << "; computing them again";
+    }
+    if (cached) {
+      data.orientation = std::move(*cached);
+    } else {
+      const FloatMap gray = ResizeArea(workspace_.ReadViewGray(name), w, h);
       const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
-        OrientationFieldOptions field_options = field_options_;
-        field_options.num_levels = options_.PyramidLevels();
         computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
       }
       data.orientation = computer_->Compute(gray, mask);
       if (options_.write_orientation_maps) {
-        for (size_t l = 0; l < data.orientation.size(); ++l) {
-          WriteMat(workspace_.OrientationMapPath(name, static_cast<int>(l)), data.orientation[l]);
-        }
+        WriteOrientationFields(workspace_, name, provenance, data.orientation);
       }
     }
     if (options_.MatchesOrientation() && options_.orientation_normalization_radius_px > 0) {
@@ -742,9 +737,14 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           1 - consistent < options.geom_consistency_min_inconsistent_fraction ||
           (previous_consistent >= 0 &&
            consistent - previous_consistent < options.geom_consistency_min_gain);
-      std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
-                  round + 1, 100 * consistent, total.num_checked,
-                  last_round ? ": the last round" : ": another round");
+      if (total.num_checked > 0) {
+        std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
+                    round + 1, 100 * consistent, total.num_checked,
+                    last_round ? ": the last round" : ": another round");
+      } else {
+        std::printf("  round %d: no depths checked (no other view has a map)%s\n", round + 1,
+                    last_round ? ": the last round" : ": another round");
+      }
       previous_consistent = consistent;
       if (last_round) {
         // The confidence of the maps that are written as .geometric.

@@ -1,0 +1,130 @@
+#include "src/orientation/orientation_maps.h"
+
+#include <zlib.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+
+#include "colmap_ext/mat_io.h"
+#include "src/core/file_util.h"
+#include "src/core/logging.h"
+#include "src/core/option_parser.h"
+
+namespace hairmvs {
+namespace {
+
+constexpr char kNumLevelsOption[] = "OrientationField.num_levels";
+
+// "<bytes> bytes, crc32 <hex>" of the file at `path`.
+std::string Fingerprint(const std::string& path) {
+  const std::string bytes = ReadTextFile(path);
+  uLong crc = crc32(0L, Z_NULL, 0);
+  // zlib takes lengths as uInt: feed the file in pieces that fit.
+  constexpr size_t kPiece = 1 << 30;
+  for (size_t offset = 0; offset < bytes.size(); offset += kPiece) {
+    const size_t length = std::min(kPiece, bytes.size() - offset);
+    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes.data() + offset),
+                static_cast<uInt>(length));
+  }
+  char hex[9];
+  std::snprintf(hex, sizeof(hex), "%08lx", crc);
+  return std::to_string(bytes.size()) + " bytes, crc32 " + hex;
+}
+
+}  // namespace
+
+std::string OrientationFieldsProvenance(const Workspace& workspace, const std::string& name,
+                                        int width, int height,
+                                        const OrientationFieldOptions& options) {
+  std::ostringstream out;
+  out << "# hairmvs orientation fields of " << name
+      << " (<name>.l<k>.bin beside this file): reused only while every line below holds\n";
+  out << "image " << Fingerprint(workspace.ImagePath(name)) << "\n";
+  const std::string mask_path = workspace.MaskPath(name);
+  out << "mask " << (mask_path.empty() ? "none" : Fingerprint(mask_path)) << "\n";
+  out << "size " << width << " x " << height << "\n";
+  // The options as the commands print them (OptionParser::Values), one per line.
+  OrientationFieldOptions copy = options;
+  OptionParser parser("orientation_fields", "");
+  parser.AddSection("OrientationField", &copy);
+  std::istringstream values(parser.Values());
+  for (std::string line; std::getline(values, line);) {
+    line = StripWhitespace(line);
+    if (line.rfind(kNumLevelsOption, 0) != 0) out << line << "\n";
+  }
+  return out.str();
+}
+
+std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
+    const Workspace& workspace, const std::string& name, const std::string& provenance,
+    const std::vector<std::array<int, 2>>& level_sizes, std::string* why_not) {
+  CHECK(why_not != nullptr);
+  why_not->clear();
+  const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
+  if (!ExistsFile(provenance_path)) {
+    if (ExistsFile(workspace.OrientationMapPath(name, 0))) {
+      *why_not = "its cached orientation fields have no " + provenance_path +
+                 " (written by an older hairmvs, or their writing was interrupted)";
+    }
+    return std::nullopt;
+  }
+  const std::string cached = ReadTextFile(provenance_path);
+  if (cached != provenance) {
+    std::istringstream was(cached), now(provenance);
+    std::string was_line, now_line;
+    while (true) {
+      const bool more_was = static_cast<bool>(std::getline(was, was_line));
+      const bool more_now = static_cast<bool>(std::getline(now, now_line));
+      if (!more_was && !more_now) break;
+      if (!more_was) was_line = "(nothing)";
+      if (!more_now) now_line = "(nothing)";
+      if (was_line != now_line) break;
+    }
+    *why_not = "its cached orientation fields were computed from other inputs (" +
+               provenance_path + " says `" + was_line + "`, now `" + now_line + "`)";
+    return std::nullopt;
+  }
+  std::vector<FloatMap> levels;
+  for (size_t l = 0; l < level_sizes.size(); ++l) {
+    const std::string path = workspace.OrientationMapPath(name, static_cast<int>(l));
+    if (!ExistsFile(path)) {
+      *why_not = "its cached orientation fields stop before level " + std::to_string(l) +
+                 " (no " + path + ")";
+      return std::nullopt;
+    }
+    FloatMap level;
+    try {
+      level = ReadMat(path);
+    } catch (const Error& e) {
+      *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
+      return std::nullopt;
+    }
+    const auto [width, height] = level_sizes[l];
+    if (level.Width() != width || level.Height() != height || level.Channels() != 2) {
+      std::ostringstream message;
+      message << path << " is " << level.Width() << " x " << level.Height() << " x "
+              << level.Channels() << ", not the " << width << " x " << height
+              << " x 2 of its level";
+      *why_not = message.str();
+      return std::nullopt;
+    }
+    levels.push_back(std::move(level));
+  }
+  return levels;
+}
+
+void WriteOrientationFields(const Workspace& workspace, const std::string& name,
+                            const std::string& provenance, const std::vector<FloatMap>& levels) {
+  const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
+  std::error_code error;
+  std::filesystem::remove(provenance_path, error);
+  THROW_IF(error, "Cannot remove " << provenance_path << ": " << error.message());
+  for (size_t l = 0; l < levels.size(); ++l) {
+    WriteMat(workspace.OrientationMapPath(name, static_cast<int>(l)), levels[l]);
+  }
+  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << provenance; },
+                      /*binary=*/false);
+}
+
+}  // namespace hairmvs

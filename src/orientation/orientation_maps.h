@@ -1,0 +1,42 @@
+#pragma once
+// The orientation fields cached in stereo/orientation_maps/: `hairmvs orientation_fields` writes
+// them and the stereo commands reuse them. Each view's levels (<name>.l<k>.bin) come with
+// <name>.provenance.txt, which says what they were computed from: the image's and the mask's
+// bytes (size and CRC-32), the size they were computed at and every filter option that shapes
+// them. They are reused only while all of it still holds, so that a replaced image or mask, or
+// another --OrientationField option, computes them again instead of silently reusing old ones.
+
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/workspace.h"
+#include "hairmvs/orientation_fields.h"
+#include "src/core/float_map.h"
+
+namespace hairmvs {
+
+// The provenance of the fields of image `name` computed at width x height with `options`,
+// as the text of its provenance file. OrientationField.num_levels is left out: level k does
+// not depend on how many levels are computed. Throws naming the file if the image or its
+// mask cannot be read.
+std::string OrientationFieldsProvenance(const Workspace& workspace, const std::string& name,
+                                        int width, int height,
+                                        const OrientationFieldOptions& options);
+
+// The cached levels of `name`, one per entry of `level_sizes` ({width, height}, level 0
+// first), if its provenance file equals `provenance` and every level is there, 2-channel and of
+// its size. Otherwise nullopt, and `*why_not` says what differs (the first line of the
+// provenance that does not hold) or what is missing; it is left empty when nothing of `name`
+// is cached at all.
+std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
+    const Workspace& workspace, const std::string& name, const std::string& provenance,
+    const std::vector<std::array<int, 2>>& level_sizes, std::string* why_not);
+
+// Writes the levels of `name`, then its provenance. The old provenance file is removed first,
+// so that levels left half-replaced by an interrupted run are never reused.
+void WriteOrientationFields(const Workspace& workspace, const std::string& name,
+                            const std::string& provenance, const std::vector<FloatMap>& levels);
+
+}  // namespace hairmvs
