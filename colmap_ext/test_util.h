@@ -1,6 +1,7 @@
 #pragma once
 // Test helpers (header-only, used by colmap_ext's tests and tests/colmap_interop): a small
-// synthetic sparse model of PINHOLE cameras looking at a plane, temporary folders, comparisons.
+// synthetic sparse model of PINHOLE cameras looking at a plane, temporary folders, comparisons;
+// with src/core/test_util.h's ErrorOf.
 
 #include <gtest/gtest.h>
 
@@ -13,20 +14,10 @@
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/core/test_util.h"  // ErrorOf
 
 namespace hairmvs {
 namespace testing_util {
-
-// The message of the hairmvs::Error that f() throws; "(no error)" when it throws none.
-template <typename F>
-std::string ErrorOf(F&& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 // A fresh, empty folder under the test temp dir.
 inline std::string MakeTestDir(const std::string& name) {

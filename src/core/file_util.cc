@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -100,8 +102,9 @@ void RenameOver(const std::string& tmp, const std::string& path) {
   std::error_code ec;
   fs::rename(tmp, path, ec);
   if (ec) {
+    const std::string why = ec.message();
     fs::remove(tmp, ec);
-    HAIRMVS_THROW("Cannot rename " << tmp << " to " << path);
+    HAIRMVS_THROW("Cannot rename " << tmp << " to " << path << ": " << why);
   }
 }
 
@@ -113,10 +116,12 @@ void WriteFileAtomically(const std::string& path,
   const std::string tmp = TemporaryPathFor(path);
   try {
     std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
-    THROW_IF(!out, "Cannot write " << path << " (temporary " << tmp << ")");
+    // errno says why the stream failed (the folder not writable, the disk full).
+    THROW_IF(!out, "Cannot write " << path << ": " << std::strerror(errno) << " (temporary "
+                                   << tmp << ")");
     write(out);
     out.flush();
-    THROW_IF(!out, "Write failed for " << path << " (disk full?)");
+    THROW_IF(!out, "Write failed for " << path << ": " << std::strerror(errno));
   } catch (...) {
     std::error_code ec;
     fs::remove(tmp, ec);

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
@@ -32,6 +33,31 @@ TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
   EXPECT_EQ(ReadTextFile(path), "first");
   int num_files = 0;
   for (const auto& entry : std::filesystem::directory_iterator(ParentPath(path))) {
+    (void)entry;
+    ++num_files;
+  }
+  EXPECT_EQ(num_files, 1);
+}
+
+// A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
+TEST(FileUtil, FailedWriteSaysWhy) {
+  const std::string dir = TestDir("failed_write");
+  auto write = [](std::ostream& out) { out << "data"; };
+  // The temporary's name (".<name>.tmp<pid>_<n>.txt") is over the file system's 255 bytes.
+  const std::string long_path = JoinPaths(dir, std::string(250, 'a') + ".txt");
+  std::string message = testing_util::ErrorOf([&] { WriteFileAtomically(long_path, write); });
+  EXPECT_NE(message.find("Cannot write " + long_path + ": File name too long"),
+            std::string::npos)
+      << message;
+  // A folder in the way of the rename.
+  const std::string folder = JoinPaths(dir, "target.txt");
+  CreateDirs(folder);
+  message = testing_util::ErrorOf([&] { WriteFileAtomically(folder, write); });
+  EXPECT_NE(message.find("Cannot rename"), std::string::npos) << message;
+  EXPECT_NE(message.find("to " + folder + ": Is a directory"), std::string::npos) << message;
+  EXPECT_TRUE(ExistsDir(folder));
+  int num_files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     (void)entry;
     ++num_files;
   }
