@@ -46,6 +46,12 @@ void CreateDirs(const std::string& path) {
   THROW_IF(ec && !ExistsDir(path), "Cannot create folder " << path << ": " << ec.message());
 }
 
+void RequireWritableDir(const std::string& path, const std::string& what) {
+  CreateDirs(path);
+  THROW_IF(access(path.c_str(), W_OK) != 0,
+           "Cannot write to the " << what << " " << path << ": " << std::strerror(errno));
+}
+
 std::string ParentPath(const std::string& path) { return fs::path(path).parent_path().string(); }
 
 std::string ReadTextFile(const std::string& path) {

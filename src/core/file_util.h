@@ -23,6 +23,9 @@ void RequireFile(const std::string& path, const std::string& what = "file");
 void RequireDir(const std::string& path, const std::string& what = "folder");
 // Creates the folder and its parents (no error if it exists).
 void CreateDirs(const std::string& path);
+// CreateDirs, then throws hairmvs::Error naming `what`, `path` and the reason unless this
+// process may write there: checked before long work whose outputs go there.
+void RequireWritableDir(const std::string& path, const std::string& what = "folder");
 std::string ParentPath(const std::string& path);
 std::string ReadTextFile(const std::string& path);
 std::vector<std::string> ReadLines(const std::string& path);

@@ -64,6 +64,19 @@ TEST(FileUtil, FailedWriteSaysWhy) {
   EXPECT_EQ(num_files, 1);
 }
 
+// A folder this process may not write to is named before any work; a missing one is made.
+TEST(FileUtil, RequireWritableDir) {
+  const std::string dir = JoinPaths(TestDir("writable"), "stereo", "depth_maps");
+  RequireWritableDir(dir, "depth map folder");
+  EXPECT_TRUE(ExistsDir(dir));
+  // procfs refuses writes to a process's folder even to root (the tests may run as root, to
+  // whom a chmod'ed folder is writable).
+  const std::string message =
+      testing_util::ErrorOf([] { RequireWritableDir("/proc/self", "depth map folder"); });
+  EXPECT_EQ(message.rfind("Cannot write to the depth map folder /proc/self: ", 0), 0u)
+      << message;
+}
+
 TEST(FileUtil, MissingFileErrorNamesThePath) {
   try {
     RequireFile("/nonexistent/hairmvs/cameras.bin", "camera file");

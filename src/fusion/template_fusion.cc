@@ -179,6 +179,8 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
   Timer total_timer;
   StageTimings local_timings;
   if (timings == nullptr) timings = &local_timings;
+  // fused.ply and meshed-hair.ply go there, after minutes of work.
+  RequireWritableDir(workspace_path, "workspace");
 
   std::vector<FusionView> views;
   std::vector<uint32_t> image_idx_of_view;

@@ -79,7 +79,10 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   }();
   std::vector<std::string> names = run_options.image_names;
   if (names.empty()) names = workspace.ImageNames();
-  for (const auto& name : names) workspace.ImageIdx(name);  // throws for an unknown name
+  for (const auto& name : names) {
+    workspace.ImageIdx(name);  // throws for an unknown name
+    RequireWritableDir(ParentPath(workspace.OrientationMapPath(name, 0)), "orientation map folder");
+  }
 
   std::shared_ptr<OpenCLContext> context;
   std::unique_ptr<OrientationFieldComputer> computer;

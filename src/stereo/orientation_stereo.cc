@@ -426,6 +426,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
   workspace.RequireUndistortedCameras();
+  // Outputs that cannot be written are found before minutes of work, not after.
+  for (const std::string& name : names) {
+    RequireWritableDir(ParentPath(workspace.DepthMapPath(name)), "depth map folder");
+    RequireWritableDir(ParentPath(workspace.NormalMapPath(name)), "normal map folder");
+    RequireWritableDir(ParentPath(workspace.ConfidenceMapPath(name)), "confidence map folder");
+  }
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
   if (workspace.MaskFolder().empty()) {
