@@ -394,6 +394,12 @@ struct OrientationStereoOptions {
   int coarse_volume_cache_mib = 2048;
   // Only the geometric pass, on the existing .photometric maps.
   bool geom_consistency_only = false;
+  // As colmap patch_match_stereo does (always, there; `hairmvs patch_match_stereo` too): a view
+  // whose .geometric depth and normal maps exist is skipped, and one whose .photometric maps
+  // exist starts at the geometric pass, so that an interrupted run resumes where it stopped.
+  // Off by default for orientation_stereo: maps already there are those of the options they
+  // were made with, not of this run's.
+  bool skip_existing = false;
   // Reuse / write stereo/orientation_maps/<name>.l<k>.bin. Cached fields are reused only while
   // their <name>.provenance.txt matches the image, the mask, the processing size and the
   // --OrientationField options in use; otherwise they are computed again (and the log says
@@ -497,6 +503,8 @@ struct OrientationStereoOptions {
       "from the third round on, another only while the last added this consistent fraction");
     v("geom_consistency_only", &geom_consistency_only,
       "only the geometric pass (prior and filter), on the existing .photometric maps");
+    v("skip_existing", &skip_existing,
+      "resume: skip views whose maps exist (as colmap patch_match_stereo; see the header)");
     v("reuse_orientation_maps", &reuse_orientation_maps,
       "reuse stereo/orientation_maps/*.l<k>.bin made from this image, mask, size and filter");
     v("write_orientation_maps", &write_orientation_maps,
@@ -527,6 +535,9 @@ struct OrientationStereoOptions {
 
 struct OrientationStereoResult {
   int num_views = 0;
+  // With skip_existing: views left as they were, and views whose first estimate was read.
+  int num_skipped = 0;
+  int num_resumed_at_geometric_pass = 0;
   int geometric_rounds = 0;  // rounds of the geometric pass that ran
   std::vector<std::string> depth_map_paths;
   double seconds = 0;

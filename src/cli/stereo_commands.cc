@@ -71,13 +71,17 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   int filter_min_num_consistent = options.geom_consistency_min_views;
   double filter_geom_consistency_max_cost = options.geom_consistency_max_error_px;
   double geom_consistency_max_cost = options.geom_prior_max_error_px;
+  // As colmap patch_match_stereo: views whose maps exist are skipped (a run resumes).
+  options.skip_existing = true;
   SourceViewOptions source_options;
   OrientationFieldOptions field_options;
   OpenCLOptions opencl_options;
   OptionParser parser("patch_match_stereo",
                       "Drop-in for `colmap patch_match_stereo`: orientation-field depth maps in "
                       "COLMAP's layout (stereo/depth_maps/<name>.geometric.bin), ready for "
-                      "`colmap stereo_fusion --input_type geometric`.");
+                      "`colmap stereo_fusion --input_type geometric`. As colmap's, it skips views "
+                      "whose maps exist, so that an interrupted run resumes "
+                      "(--OrientationStereo.skip_existing 0 computes them all again).");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
   parser.Add("workspace_format", &workspace_format, "COLMAP (PMVS is not supported)");
   parser.Add("PatchMatchStereo.max_image_size", &max_image_size,

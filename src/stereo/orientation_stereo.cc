@@ -193,6 +193,11 @@ bool OrientationStereoOptions::Check(std::string* error) const {
 std::string OrientationStereoResult::BriefReport() const {
   std::ostringstream out;
   out << "orientation_stereo: " << num_views << " depth maps";
+  if (num_skipped > 0) out << " (" << num_skipped << " views skipped: their maps exist)";
+  if (num_resumed_at_geometric_pass > 0) {
+    out << " (" << num_resumed_at_geometric_pass
+        << " views resumed at the geometric pass: their .photometric maps exist)";
+  }
   if (geometric_rounds > 1) out << " (geometric pass in " << geometric_rounds << " rounds)";
   out << " in " << seconds << " s; peak memory " << peak_memory_mib << " MiB";
   return out.str();
@@ -392,6 +397,13 @@ class ViewLoader {
   std::vector<std::pair<std::string, std::pair<StereoCamera, FloatMap>>> masked_views_;
 };
 
+// Whether the `type` (geometric or photometric) depth and normal maps of `name` exist.
+bool HasDepthAndNormals(const Workspace& workspace, const std::string& name,
+                        const std::string& type) {
+  return ExistsFile(workspace.DepthMapPath(name, type)) &&
+         ExistsFile(workspace.NormalMapPath(name, type));
+}
+
 // Writes a depth map, its normal map and, with `png`, their pictures, as `type` (geometric or
 // photometric) maps.
 void WriteDepthAndNormals(const Workspace& workspace, const std::string& name,
@@ -456,9 +468,31 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   THROW_IF(!fields.Check(&error), "invalid --OrientationField options: " << error);
   ViewLoader loader(workspace, options, fields, context, timings);
   OrientationStereoResult result;
-  std::vector<std::string> estimated;  // views whose depth map was estimated in this run
-  const std::vector<std::string> no_names;
-  const std::vector<std::string>& to_estimate = options.geom_consistency_only ? no_names : names;
+  // The views this run computes (all of `names` but those skip_existing finds done), those it
+  // estimates first and those that start at the geometric pass.
+  std::vector<std::string> to_run, to_estimate;
+  std::set<std::string> resumed;
+  for (const std::string& name : names) {
+    if (options.skip_existing && HasDepthAndNormals(workspace, name, "geometric")) {
+      std::printf("  %s: skipped: its .geometric depth and normal maps exist (delete them to "
+                  "compute it again)\n", name.c_str());
+      ++result.num_skipped;
+      continue;
+    }
+    to_run.push_back(name);
+    if (options.geom_consistency_only) continue;
+    if (options.skip_existing && options.geom_consistency &&
+        HasDepthAndNormals(workspace, name, "photometric")) {
+      std::printf("  %s: its .photometric depth and normal maps exist: resumed at the "
+                  "geometric pass\n", name.c_str());
+      resumed.insert(name);
+      ++result.num_resumed_at_geometric_pass;
+      continue;
+    }
+    to_estimate.push_back(name);
+  }
+  std::fflush(stdout);
+  std::set<std::string> estimated;  // views whose depth map was estimated in this run
   Progress progress("orientation_stereo", static_cast<int>(to_estimate.size()));
   // One view's depth map, with the other views' maps as a prior in the geometric pass; nothing
   // when the view has no source views.
@@ -591,7 +625,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                         view->estimate.coarse_data_term);
       }
     }
-    estimated.push_back(name);
+    estimated.insert(name);
     if (!options.geom_consistency) {
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
       ++result.num_views;
@@ -600,14 +634,19 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   progress.Finish();
 
   if (options.geom_consistency) {
-    // The geometric pass: every view estimated now (or, with geom_consistency_only, every
-    // requested view) is estimated again with its sources' maps (and those of the views
+    // The geometric pass: every view estimated now or resumed here (or, with
+    // geom_consistency_only, every requested view) is estimated again with its sources' maps (and those of the views
     // looking the same way, below) as a prior, in rounds (each
     // from the previous round's maps of every view, the .photometric ones first, so that the
     // order of the views does not matter), and its final map filtered by consistency with the
     // maps its prior came from (as COLMAP's geometric pass filters against the maps it reads:
     // with one round, a job of an array gives the map one process would).
-    const std::vector<std::string>& to_filter = options.geom_consistency_only ? names : estimated;
+    std::vector<std::string> to_filter;  // in the order of `names`
+    for (const std::string& name : to_run) {
+      if (options.geom_consistency_only || estimated.count(name) > 0 || resumed.count(name) > 0) {
+        to_filter.push_back(name);
+      }
+    }
     // Each view's latest map but the last round's: its .photometric map (read once), then
     // each round's estimate.
     std::map<std::string, FusionView> latest;

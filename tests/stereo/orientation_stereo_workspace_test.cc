@@ -210,8 +210,54 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   EXPECT_EQ(cached.Data(), ReadMat(fields_ws.OrientationMapPath("v1.png", 0)).Data());
   RunOrientationFields(fields_path, OrientationFieldOptions(), OrientationFieldsRunOptions(),
                        &timings);
-  EXPECT_NE(cached.Data(), ReadMat(fields_ws.OrientationMapPath("v1.png", 0)).Data());
+  const FloatMap default_field = ReadMat(fields_ws.OrientationMapPath("v1.png", 0));
+  EXPECT_NE(cached.Data(), default_field.Data());
+  // The stereo run again with the default filter does not take the paper filter's cached
+  // fields for its own: it computes them again (their provenance names the other filter).
+  RunOrientationStereo(stereo_path, {"v0.png"}, options, &timings);
+  EXPECT_EQ(ReadMat(stereo_ws.OrientationMapPath("v1.png", 0)).Data(), default_field.Data());
   std::filesystem::remove_all(root);
+}
+
+// skip_existing (colmap patch_match_stereo's behaviour): a view whose .geometric maps exist is
+// left as it is, one whose .photometric maps exist starts at the geometric pass, the others are
+// estimated, as an interrupted run would need.
+TEST(OrientationStereoWorkspace, SkipExistingResumesWhereARunStopped) {
+  const std::string path = MakeTestDir("stereo_resume");
+  WriteWorkspace(path);
+  OrientationStereoOptions options = PlaneOptions();
+  StageTimings timings;
+  ASSERT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  const Workspace workspace = Workspace::Read(path);
+  const FloatMap v2_photometric = ReadMat(workspace.DepthMapPath("v2.png", "photometric"));
+  // v0 done (its map replaced by a marker), v1 stopped after its first estimate (a marker
+  // too), v2 not begun; v3 done.
+  FloatMap marker(96, 72, 1);
+  std::fill(marker.Data().begin(), marker.Data().end(), 0.9f);
+  WriteMat(workspace.DepthMapPath("v0.png", "geometric"), marker);
+  WriteMat(workspace.DepthMapPath("v1.png", "photometric"), marker);
+  std::filesystem::remove(workspace.DepthMapPath("v1.png", "geometric"));
+  for (const char* type : {"photometric", "geometric"}) {
+    std::filesystem::remove(workspace.DepthMapPath("v2.png", type));
+  }
+  options.skip_existing = true;
+  const OrientationStereoResult result = RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_EQ(result.num_skipped, 2);
+  EXPECT_EQ(result.num_resumed_at_geometric_pass, 1);
+  EXPECT_EQ(result.num_views, 2);
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), marker.Data());
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v1.png", "photometric")).Data(), marker.Data());
+  EXPECT_TRUE(ExistsFile(workspace.DepthMapPath("v1.png", "geometric")));
+  EXPECT_TRUE(ExistsFile(workspace.NormalMapPath("v1.png", "geometric")));
+  // v2's first estimate is the one the full run made (it depends on no other map).
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v2.png", "photometric")).Data(),
+            v2_photometric.Data());
+  EXPECT_TRUE(ExistsFile(workspace.DepthMapPath("v2.png", "geometric")));
+  // Without skip_existing every view is computed again.
+  options.skip_existing = false;
+  EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, options, &timings).num_views, 1);
+  EXPECT_NE(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), marker.Data());
+  std::filesystem::remove_all(path);
 }
 
 TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhotometricPixels) {
