@@ -110,10 +110,16 @@ struct OrientationFieldsRunOptions {
   std::string mask_path;
   // --OpenCL.device (see src/opencl/opencl_options.h).
   std::string opencl_device;
+  // An image whose fields in stereo/orientation_maps/ are up to date (their provenance holds:
+  // the same image and mask bytes, size and filter options; with write_png, its pictures
+  // there) is not computed again, as colmap feature_extractor skips the images it has
+  // features of. false: every image is computed again.
+  bool skip_up_to_date = true;
 };
 
 struct OrientationFieldsResult {
-  int num_images = 0;
+  int num_images = 0;  // computed
+  int num_up_to_date = 0;  // skipped: up to date (skip_up_to_date)
   int num_levels = 0;
   int num_files_written = 0;
   double seconds = 0;
@@ -123,7 +129,8 @@ struct OrientationFieldsResult {
 
 // Writes W/stereo/orientation_maps/<image name>.l<k>.bin (2-channel Mat: Re O, Im O) for
 // every level k, and <image name>.provenance.txt: what they were computed from, so that the
-// stereo reuses them only while that holds (src/orientation/orientation_maps.h). Adds the per-stage times to `timings` (may be null).
+// stereo reuses them only while that holds (src/orientation/orientation_maps.h). Adds the
+// per-stage times to `timings` (may be null).
 OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
                                              const OrientationFieldOptions& options,
                                              const OrientationFieldsRunOptions& run_options,

@@ -47,6 +47,8 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
   parser.Add("mask_path", &run_options.mask_path,
              "masks folder (<image name>.png, 0 = excluded; default: <workspace>/masks if any)");
   parser.Add("write_png", &run_options.write_png, "also write <...>.l<k>.png pictures");
+  parser.Add("skip_up_to_date", &run_options.skip_up_to_date,
+             "keep the images whose cached fields' provenance holds (0: compute all again)");
   parser.Add("timing", &timing, "print the per-stage timing table");
   parser.AddSection("OrientationField", &options);
   parser.AddSection("OpenCL", &opencl_options);

@@ -61,7 +61,9 @@ std::string PngPathFor(const std::string& bin_path) {
 
 std::string OrientationFieldsResult::BriefReport() const {
   std::ostringstream out;
-  out << "Orientation fields: " << num_images << " image(s), " << num_levels << " level(s), "
+  out << "Orientation fields: " << num_images << " image(s)";
+  if (num_up_to_date > 0) out << " (and " << num_up_to_date << " up to date, kept)";
+  out << ", " << num_levels << " level(s), "
       << num_files_written << " file(s) written in " << seconds << " s on " << device_name;
   return out.str();
 }
@@ -100,6 +102,28 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string& name = names[i];
     progress.Start(static_cast<int>(i), name);
+    const StereoCamera camera = workspace.ViewCamera(name);
+    const std::string provenance =
+        OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
+    if (run_options.skip_up_to_date) {
+      std::vector<std::array<int, 2>> sizes;
+      for (int l = 0; l < options.num_levels; ++l) {
+        const StereoCamera level = camera.PyramidLevel(l);
+        sizes.push_back({level.width, level.height});
+      }
+      std::string why_not;
+      bool up_to_date =
+          ReadCachedOrientationFields(workspace, name, provenance, sizes, &why_not).has_value();
+      for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
+        up_to_date = ExistsFile(PngPathFor(workspace.OrientationMapPath(name, l)));
+      }
+      if (up_to_date) {
+        progress.Stage("up to date (its provenance holds): kept");
+        ++result.num_up_to_date;
+        continue;
+      }
+      if (!why_not.empty()) progress.Stage(why_not + ": computing them again");
+    }
     FloatMap gray, mask;
     {
       ScopedStageTimer timer(timings, "read image");
@@ -111,10 +135,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     const std::vector<FloatMap> levels = computer->Compute(gray, mask);
     progress.Stage("write");
     ScopedStageTimer timer(timings, "write");
-    WriteOrientationFields(
-        workspace, name,
-        OrientationFieldsProvenance(workspace, name, gray.Width(), gray.Height(), options),
-        levels);
+    WriteOrientationFields(workspace, name, provenance, levels);
     result.num_files_written += static_cast<int>(levels.size()) + 1;
     if (run_options.write_png) {
       for (int l = 0; l < static_cast<int>(levels.size()); ++l) {

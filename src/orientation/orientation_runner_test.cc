@@ -147,7 +147,25 @@ TEST(RunOrientationFields, ImageSubsetAndErrors) {
 // were computed from still hold, and only then; each miss says why.
 TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   const std::string root = MakeWorkspace();
-  RunOrientationFields(root, OrientationFieldOptions(), OrientationFieldsRunOptions(), nullptr);
+  OrientationFieldsRunOptions run_options;
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr).num_images,
+            2);
+  // orientation_fields itself keeps what is up to date, computes what is not, and everything
+  // with skip_up_to_date 0.
+  OrientationFieldsResult again =
+      RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
+  EXPECT_EQ(again.num_images, 0);
+  EXPECT_EQ(again.num_up_to_date, 2);
+  run_options.write_png = true;  // the pictures are missing
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr).num_images,
+            2);
+  OrientationFieldOptions narrow;
+  narrow.sigma_along_px = 3;
+  EXPECT_EQ(RunOrientationFields(root, narrow, run_options, nullptr).num_images, 2);
+  run_options.skip_up_to_date = false;
+  again = RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
+  EXPECT_EQ(again.num_images, 2);
+  EXPECT_EQ(again.num_up_to_date, 0);
   const Workspace workspace = Workspace::Read(root);
   const std::vector<std::array<int, 2>> sizes = {{80, 60}, {40, 30}, {20, 15}};
   auto read = [&](const std::string& name, const OrientationFieldOptions& options,
