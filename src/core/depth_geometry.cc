@@ -28,6 +28,13 @@ StereoCamera StereoCamera::Scaled(int new_width, int new_height) const {
   return scaled;
 }
 
+StereoCamera StereoCamera::AtMaxImageSize(int max_image_size) const {
+  if (max_image_size <= 0 || std::max(width, height) <= max_image_size) return *this;
+  const double scale = static_cast<double>(max_image_size) / std::max(width, height);
+  return Scaled(std::max(1, static_cast<int>(std::lround(width * scale))),
+                std::max(1, static_cast<int>(std::lround(height * scale))));
+}
+
 StereoCamera StereoCamera::PyramidLevel(int level) const {
   CHECK_GE(level, 0);
   StereoCamera scaled = *this;

@@ -39,6 +39,9 @@ struct StereoCamera {
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // The same camera for an image of width x height covering the same extent (a resized image).
   StereoCamera Scaled(int new_width, int new_height) const;
+  // Scaled to COLMAP's max_image_size rule: the longer side at most `max_image_size` (scale,
+  // round); itself when max_image_size <= 0 or the image is no larger.
+  StereoCamera AtMaxImageSize(int max_image_size) const;
   // The camera of level `level` of the 2 x 2 box pyramid (DownsampleHalf in
   // src/orientation/orientation_field.h): image coordinates halve exactly at every level and the
   // size is ceil(size / 2^level). Not Scaled(ceil(W / 2^level), ...): for an odd size the last

@@ -26,6 +26,25 @@ TEST(DepthGeometry, BackProjectUsesPixelCentres) {
   EXPECT_DOUBLE_EQ(X(2), 1.5);
 }
 
+// COLMAP's max_image_size: the longer side scaled to it and rounded, the intrinsics with it.
+TEST(DepthGeometry, AtMaxImageSizeFollowsColmapsRule) {
+  StereoCamera camera;
+  camera.K << 767.783, 0, 480, 0, 767.783, 320, 0, 0, 1;
+  camera.width = 960;
+  camera.height = 640;
+  const StereoCamera small = camera.AtMaxImageSize(320);
+  EXPECT_EQ(small.width, 320);
+  EXPECT_EQ(small.height, 213);  // 640 / 3 = 213.3
+  EXPECT_NEAR(small.K(0, 0), 767.783 / 3, 1e-9);
+  EXPECT_NEAR(small.K(1, 2), 320 * 213.0 / 640, 1e-9);
+  for (const int unchanged : {-1, 0, 960, 2000}) {
+    const StereoCamera same = camera.AtMaxImageSize(unchanged);
+    EXPECT_EQ(same.width, 960) << unchanged;
+    EXPECT_EQ(same.height, 640) << unchanged;
+    EXPECT_EQ(same.K, camera.K) << unchanged;
+  }
+}
+
 // A camera's pixel round-trips through the world and back, on its own grid and on a scaled
 // one (where the same world point lands at the scaled pixel centre's cell); off the grid and
 // behind the camera it has no pixel.

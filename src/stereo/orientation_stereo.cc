@@ -205,17 +205,6 @@ std::string OrientationStereoResult::BriefReport() const {
 
 namespace {
 
-// Processing size: the longer side at most max_image_size (COLMAP's rule: scale, round).
-void ProcessingSize(int width, int height, int max_image_size, int* out_w, int* out_h) {
-  *out_w = width;
-  *out_h = height;
-  if (max_image_size > 0 && std::max(width, height) > max_image_size) {
-    const double scale = static_cast<double>(max_image_size) / std::max(width, height);
-    *out_w = std::max(1, static_cast<int>(std::lround(width * scale)));
-    *out_h = std::max(1, static_cast<int>(std::lround(height * scale)));
-  }
-}
-
 FloatMap ResizeArea(const FloatMap& input, int width, int height) {
   if (input.Width() == width && input.Height() == height) return input;
   FloatMap out(width, height, input.Channels());
@@ -301,10 +290,7 @@ class ViewLoader {
 
   // The camera at the processing resolution.
   StereoCamera ProcessingCamera(const std::string& name) const {
-    const StereoCamera full = workspace_.ViewCamera(name);
-    int w, h;
-    ProcessingSize(full.width, full.height, options_.max_image_size, &w, &h);
-    return full.Scaled(w, h);
+    return workspace_.ViewCamera(name).AtMaxImageSize(options_.max_image_size);
   }
 
   // Camera and mask at the processing resolution of every view that has a mask except
