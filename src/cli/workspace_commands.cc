@@ -1,6 +1,5 @@
 // Commands on a COLMAP dense workspace as a whole.
 
-#include <array>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -31,18 +30,13 @@ void PrintOutputs(const Workspace& workspace, const OrientationFieldOptions& fie
   const std::vector<std::string>& names = workspace.ImageNames();
   for (const std::string& name : names) {
     const StereoCamera camera = workspace.ViewCamera(name).AtMaxImageSize(max_image_size);
-    std::vector<std::array<int, 2>> sizes;
-    for (int l = 0; l < field_options.num_levels; ++l) {
-      const StereoCamera level = camera.PyramidLevel(l);
-      sizes.push_back({level.width, level.height});
-    }
     std::string why_not;
     const bool fields_ok =
         ReadCachedOrientationFields(
             workspace, name,
             OrientationFieldsProvenance(workspace, name, camera.width, camera.height,
                                         field_options),
-            sizes, &why_not)
+            camera, field_options.num_levels, &why_not)
             .has_value();
     up_to_date += fields_ok;
     stale += !fields_ok && !why_not.empty();

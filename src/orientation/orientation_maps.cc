@@ -58,7 +58,7 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
 
 std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
-    const std::vector<std::array<int, 2>>& level_sizes, std::string* why_not) {
+    const StereoCamera& camera, int num_levels, std::string* why_not) {
   CHECK(why_not != nullptr);
   why_not->clear();
   const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
@@ -86,8 +86,8 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     return std::nullopt;
   }
   std::vector<FloatMap> levels;
-  for (size_t l = 0; l < level_sizes.size(); ++l) {
-    const std::string path = workspace.OrientationMapPath(name, static_cast<int>(l));
+  for (int l = 0; l < num_levels; ++l) {
+    const std::string path = workspace.OrientationMapPath(name, l);
     if (!ExistsFile(path)) {
       *why_not = "its cached orientation fields stop before level " + std::to_string(l) +
                  " (no " + path + ")";
@@ -100,7 +100,8 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
       *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
       return std::nullopt;
     }
-    const auto [width, height] = level_sizes[l];
+    const StereoCamera level_camera = camera.PyramidLevel(l);
+    const int width = level_camera.width, height = level_camera.height;
     if (level.Width() != width || level.Height() != height || level.Channels() != 2) {
       std::ostringstream message;
       message << path << " is " << level.Width() << " x " << level.Height() << " x "

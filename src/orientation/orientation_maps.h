@@ -6,7 +6,6 @@
 // them. They are reused only while all of it still holds, so that a replaced image or mask, or
 // another --OrientationField option, computes them again instead of silently reusing old ones.
 
-#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,14 +24,14 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
                                         int width, int height,
                                         const OrientationFieldOptions& options);
 
-// The cached levels of `name`, one per entry of `level_sizes` ({width, height}, level 0
-// first), if its provenance file equals `provenance` and every level is there, 2-channel and of
-// its size. Otherwise nullopt, and `*why_not` says what differs (the first line of the
-// provenance that does not hold) or what is missing; it is left empty when nothing of `name`
-// is cached at all.
+// The cached levels [0, num_levels) of `name`, computed for `camera` (its size, and its
+// PyramidLevel(k)'s for level k), if its provenance file equals `provenance` and every level is
+// there, 2-channel and of its size. Otherwise nullopt, and `*why_not` says what differs (the
+// first line of the provenance that does not hold) or what is missing; it is left empty when
+// nothing of `name` is cached at all.
 std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
-    const std::vector<std::array<int, 2>>& level_sizes, std::string* why_not);
+    const StereoCamera& camera, int num_levels, std::string* why_not);
 
 // Writes the levels of `name`, then its provenance. The old provenance file is removed first,
 // so that levels left half-replaced by an interrupted run are never reused.

@@ -106,14 +106,10 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     const std::string provenance =
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
     if (run_options.skip_up_to_date) {
-      std::vector<std::array<int, 2>> sizes;
-      for (int l = 0; l < options.num_levels; ++l) {
-        const StereoCamera level = camera.PyramidLevel(l);
-        sizes.push_back({level.width, level.height});
-      }
       std::string why_not;
-      bool up_to_date =
-          ReadCachedOrientationFields(workspace, name, provenance, sizes, &why_not).has_value();
+      bool up_to_date = ReadCachedOrientationFields(workspace, name, provenance, camera,
+                                                    options.num_levels, &why_not)
+                            .has_value();
       for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
         up_to_date = ExistsFile(PngPathFor(workspace.OrientationMapPath(name, l)));
       }

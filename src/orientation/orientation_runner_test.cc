@@ -167,12 +167,13 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   EXPECT_EQ(again.num_images, 2);
   EXPECT_EQ(again.num_up_to_date, 0);
   const Workspace workspace = Workspace::Read(root);
-  const std::vector<std::array<int, 2>> sizes = {{80, 60}, {40, 30}, {20, 15}};
+  // Levels of 80 x 60, 40 x 30 and 20 x 15.
+  const StereoCamera camera = workspace.ViewCamera("a.png");
   auto read = [&](const std::string& name, const OrientationFieldOptions& options,
                   std::string* why_not, int width = kWidth, int height = kHeight) {
     return ReadCachedOrientationFields(
         workspace, name, OrientationFieldsProvenance(workspace, name, width, height, options),
-        sizes, why_not);
+        camera, 3, why_not);
   };
   std::string why_not;
   OrientationFieldOptions options;

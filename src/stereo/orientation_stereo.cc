@@ -325,12 +325,6 @@ class ViewLoader {
     data.camera = ProcessingCamera(name);
     const int w = data.camera.width, h = data.camera.height;
 
-    // Expected level sizes.
-    std::vector<std::array<int, 2>> sizes;
-    for (int l = 0; l < options_.PyramidLevels(); ++l) {
-      const StereoCamera level = data.camera.PyramidLevel(l);
-      sizes.push_back({level.width, level.height});
-    }
     // The fields are those of the filter options in use at this size, whatever computed them.
     OrientationFieldOptions field_options = field_options_;
     field_options.num_levels = options_.PyramidLevels();
@@ -341,7 +335,8 @@ class ViewLoader {
     std::optional<std::vector<FloatMap>> cached;
     if (options_.reuse_orientation_maps) {
       std::string why_not;
-      cached = ReadCachedOrientationFields(workspace_, name, provenance, sizes, &why_not);
+      cached = ReadCachedOrientationFields(workspace_, name, provenance, data.camera,
+                                           options_.PyramidLevels(), &why_not);
       if (!why_not.empty()) LOG(INFO) << name << ": " << why_not << "; computing them again";
     }
     if (cached) {
