@@ -297,8 +297,14 @@ struct OrientationStereoOptions {
   // reprojection error within geom_consistency_max_error_px, COLMAP's
   // filter_geom_consistency_max_cost; src/stereo/consistency_filter.h) as .geometric.bin.
   // Sources without a .photometric map yet (a job array's other jobs) are skipped; run again
-  // with geom_consistency_only once all jobs are done. Off: .geometric.bin is the estimate.
+  // with geom_consistency_only once all jobs are done. Off: the estimate is written as
+  // single_pass_type.
   bool geom_consistency = true;
+  // The name of the maps of a run without geom_consistency: "geometric" (what colmap
+  // stereo_fusion's default --input_type reads) or "photometric" (what colmap
+  // patch_match_stereo writes without its geometric pass, and so `hairmvs patch_match_stereo
+  // --PatchMatchStereo.geom_consistency 0` too).
+  std::string single_pass_type = "geometric";
   double geom_consistency_max_error_px = 4.0;
   int geom_consistency_min_views = 1;
   // 4 px rather than COLMAP's 1: the hair's own depth texture is a few pixels of disparity
@@ -481,6 +487,8 @@ struct OrientationStereoOptions {
       "per pixel and depth, sum only this fraction of the sources, those matching best (1: all)");
     v("geom_consistency", &geom_consistency,
       "write .photometric (as estimated) and .geometric (consistency-filtered) maps");
+    v("single_pass_type", &single_pass_type,
+      "geometric|photometric: the maps' name without geom_consistency");
     v("geom_consistency_max_error_px", &geom_consistency_max_error_px,
       "consistency: largest forward-backward reprojection error in px");
     v("geom_consistency_min_views", &geom_consistency_min_views,

@@ -150,6 +150,11 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   if (parser.WasGiven("PatchMatchStereo.filter_geom_consistency_max_cost")) {
     options.geom_consistency_max_error_px = filter_geom_consistency_max_cost;
   }
+  // As colmap's: without its geometric pass the maps are named .photometric; with it but
+  // unfiltered (filter 0, below), .geometric.
+  if (!parser.WasGiven("OrientationStereo.single_pass_type")) {
+    options.single_pass_type = options.geom_consistency ? "geometric" : "photometric";
+  }
   if (!filter) {
     options.geom_consistency = false;
     options.filter_range_ends = false;

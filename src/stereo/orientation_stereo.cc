@@ -149,6 +149,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   }
   if (coarse_volume_cache_mib < 0) e << "coarse_volume_cache_mib must be >= 0; ";
   if (geom_consistency_min_views < 0) e << "geom_consistency_min_views must be >= 0; ";
+  if (single_pass_type != "geometric" && single_pass_type != "photometric") {
+    e << "single_pass_type must be geometric or photometric, not '" << single_pass_type << "'; ";
+  }
   if (geom_consistency_only && !geom_consistency) {
     e << "geom_consistency_only needs geom_consistency; ";
   }
@@ -453,10 +456,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   // estimates first and those that start at the geometric pass.
   std::vector<std::string> to_run, to_estimate;
   std::set<std::string> resumed;
+  // The maps a view ends with.
+  const std::string final_type = options.geom_consistency ? "geometric" : options.single_pass_type;
   for (const std::string& name : names) {
-    if (options.skip_existing && HasDepthAndNormals(workspace, name, "geometric")) {
-      std::printf("  %s: skipped: its .geometric depth and normal maps exist (delete them to "
-                  "compute it again)\n", name.c_str());
+    if (options.skip_existing && HasDepthAndNormals(workspace, name, final_type)) {
+      std::printf("  %s: skipped: its .%s depth and normal maps exist (delete them to compute "
+                  "it again)\n", name.c_str(), final_type.c_str());
       ++result.num_skipped;
       continue;
     }
@@ -598,7 +603,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     progress.Stage("writing");
     {
       ScopedStageTimer timer(timings, "writing");
-      WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : "geometric",
+      WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : final_type,
                            view->estimate.depth, view->K, options.write_png);
       WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);
       if (options.write_cost_volume) {
@@ -608,7 +613,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     estimated.insert(name);
     if (!options.geom_consistency) {
-      result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
+      result.depth_map_paths.push_back(workspace.DepthMapPath(name, final_type));
       ++result.num_views;
     }
   }

@@ -219,6 +219,31 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   std::filesystem::remove_all(root);
 }
 
+// Without geom_consistency the maps are named as single_pass_type says: .photometric is what
+// colmap patch_match_stereo writes without its geometric pass.
+TEST(OrientationStereoWorkspace, SinglePassMapsAreNamedAsAsked) {
+  const std::string path = MakeTestDir("stereo_single_pass");
+  WriteWorkspace(path);
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_consistency = false;
+  options.single_pass_type = "photometric";
+  StageTimings timings;
+  const OrientationStereoResult result = RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  const Workspace workspace = Workspace::Read(path);
+  ASSERT_EQ(result.depth_map_paths.size(), 1u);
+  EXPECT_EQ(result.depth_map_paths[0], workspace.DepthMapPath("v0.png", "photometric"));
+  EXPECT_TRUE(ExistsFile(workspace.NormalMapPath("v0.png", "photometric")));
+  EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v0.png", "geometric")));
+  // skip_existing looks for the maps of that name.
+  options.skip_existing = true;
+  EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, options, &timings).num_skipped, 1);
+  options.single_pass_type = "colour";
+  EXPECT_NE(ErrorOf([&] { RunOrientationStereo(path, {"v0.png"}, options, &timings); })
+                .find("single_pass_type must be geometric or photometric, not 'colour'"),
+            std::string::npos);
+  std::filesystem::remove_all(path);
+}
+
 // skip_existing (colmap patch_match_stereo's behaviour): a view whose .geometric maps exist is
 // left as it is, one whose .photometric maps exist starts at the geometric pass, the others are
 // estimated, as an interrupted run would need.
