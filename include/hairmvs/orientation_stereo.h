@@ -570,4 +570,20 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                              const OrientationFieldOptions* field_options =
                                                  nullptr);
 
+// What the workspace holds of a view already (`hairmvs workspace_info`), so that a user or a
+// cluster's array sees what is left to run.
+struct ViewOutputs {
+  std::string name;
+  enum class Fields { kNone, kUpToDate, kStale };
+  // The cached orientation fields, against what RunOrientationStereo with these options would
+  // compute: its processing size (max_image_size) and pyramid levels, and `field_options`.
+  Fields fields = Fields::kNone;
+  std::string why_stale;  // the provenance line that no longer holds, or what is missing
+  bool photometric_maps = false;  // .photometric depth and normal maps
+  bool geometric_maps = false;
+};
+std::vector<ViewOutputs> WorkspaceOutputs(const std::string& workspace_path,
+                                          const OrientationStereoOptions& options,
+                                          const OrientationFieldOptions& field_options);
+
 }  // namespace hairmvs

@@ -621,10 +621,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
   if (options.geom_consistency) {
     // The geometric pass: every view estimated now or resumed here (or, with
-    // geom_consistency_only, every requested view) is estimated again with its sources' maps (and those of the views
-    // looking the same way, below) as a prior, in rounds (each
-    // from the previous round's maps of every view, the .photometric ones first, so that the
-    // order of the views does not matter), and its final map filtered by consistency with the
+    // geom_consistency_only, every requested view) is estimated again with its sources' maps
+    // (and those of the views looking the same way, below) as a prior, in rounds (each from the
+    // previous round's maps of every view, the .photometric ones first, so that the order of
+    // the views does not matter), and its final map filtered by consistency with the
     // maps its prior came from (as COLMAP's geometric pass filters against the maps it reads:
     // with one round, a job of an array gives the map one process would).
     std::vector<std::string> to_filter;  // in the order of `names`
@@ -837,6 +837,30 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   result.seconds = total_timer.ElapsedSeconds();
   result.peak_memory_mib = PeakResidentMemoryMiB();
   return result;
+}
+
+std::vector<ViewOutputs> WorkspaceOutputs(const std::string& workspace_path,
+                                          const OrientationStereoOptions& options,
+                                          const OrientationFieldOptions& field_options) {
+  const Workspace workspace = Workspace::Read(workspace_path);
+  std::vector<ViewOutputs> outputs;
+  for (const std::string& name : workspace.ImageNames()) {
+    ViewOutputs view;
+    view.name = name;
+    const StereoCamera camera = workspace.ViewCamera(name).AtMaxImageSize(options.max_image_size);
+    const std::string provenance =
+        OrientationFieldsProvenance(workspace, name, camera.width, camera.height, field_options);
+    if (ReadCachedOrientationFields(workspace, name, provenance, camera, options.PyramidLevels(),
+                                    &view.why_stale)) {
+      view.fields = ViewOutputs::Fields::kUpToDate;
+    } else if (!view.why_stale.empty()) {
+      view.fields = ViewOutputs::Fields::kStale;
+    }
+    view.photometric_maps = HasDepthAndNormals(workspace, name, "photometric");
+    view.geometric_maps = HasDepthAndNormals(workspace, name, "geometric");
+    outputs.push_back(std::move(view));
+  }
+  return outputs;
 }
 
 }  // namespace hairmvs

@@ -219,6 +219,38 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   std::filesystem::remove_all(root);
 }
 
+// WorkspaceOutputs (workspace_info) says what a run left: the fields every view's estimate
+// cached, the reference's maps, and which fields another filter would compute again.
+TEST(OrientationStereoWorkspace, WorkspaceOutputsSaysWhatIsLeft) {
+  const std::string path = MakeTestDir("stereo_outputs");
+  WriteWorkspace(path);
+  const OrientationStereoOptions options = PlaneOptions();
+  const OrientationFieldOptions fields;
+  for (const ViewOutputs& view : WorkspaceOutputs(path, options, fields)) {
+    EXPECT_EQ(view.fields, ViewOutputs::Fields::kNone) << view.name;
+    EXPECT_FALSE(view.photometric_maps || view.geometric_maps) << view.name;
+  }
+  StageTimings timings;
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  std::vector<ViewOutputs> views = WorkspaceOutputs(path, options, fields);
+  ASSERT_EQ(views.size(), 4u);
+  for (const ViewOutputs& view : views) {
+    // v0 and its three sources had their fields computed and cached.
+    EXPECT_EQ(view.fields, ViewOutputs::Fields::kUpToDate) << view.name << ": " << view.why_stale;
+    EXPECT_EQ(view.photometric_maps, view.name == "v0.png") << view.name;
+    EXPECT_EQ(view.geometric_maps, view.name == "v0.png") << view.name;
+  }
+  OrientationFieldOptions narrow;
+  narrow.sigma_along_px = 3;
+  views = WorkspaceOutputs(path, options, narrow);
+  EXPECT_EQ(views[0].fields, ViewOutputs::Fields::kStale);
+  EXPECT_NE(views[0].why_stale.find("`OrientationField.sigma_along_px = 4`, now "
+                                    "`OrientationField.sigma_along_px = 3`"),
+            std::string::npos)
+      << views[0].why_stale;
+  std::filesystem::remove_all(path);
+}
+
 // Without geom_consistency the maps are named as single_pass_type says: .photometric is what
 // colmap patch_match_stereo writes without its geometric pass.
 TEST(OrientationStereoWorkspace, SinglePassMapsAreNamedAsAsked) {
