@@ -1,5 +1,6 @@
 #include "colmap_ext/mat_io.h"
 
+#include <algorithm>
 #include <cstdlib>
 #include <cstring>
 #include <iomanip>
@@ -13,8 +14,10 @@ namespace hairmvs {
 
 static_assert(sizeof(float) == 4, "float32 expected");
 
-FloatMap ReadMat(std::istream& in, const std::string& source) {
-  // The header is read field by field as COLMAP does: W & H & C &; no newline may follow.
+namespace {
+
+// The header, read field by field as COLMAP does: W & H & C &; no newline may follow.
+MatShape ReadMatHeader(std::istream& in, const std::string& source) {
   long width = 0, height = 0, channels = 0;
   char sep1 = 0, sep2 = 0, sep3 = 0;
   in >> width >> sep1 >> height >> sep2 >> channels >> sep3;
@@ -24,24 +27,59 @@ FloatMap ReadMat(std::istream& in, const std::string& source) {
   THROW_IF(width <= 0 || height <= 0 || channels <= 0 || width > (1 << 16) ||
                height > (1 << 16) || channels > 4096,
            source << ": invalid Mat dimensions " << width << "x" << height << "x" << channels);
-  FloatMap map(static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels));
-  const std::streamsize num_bytes =
-      static_cast<std::streamsize>(map.Data().size() * sizeof(float));
-  in.read(reinterpret_cast<char*>(map.Data().data()), num_bytes);
-  THROW_IF(in.gcount() != num_bytes, source << ": truncated Mat file: expected " << num_bytes
-                                            << " bytes of data for " << width << "x" << height
-                                            << "x" << channels << ", found " << in.gcount());
-  THROW_IF(in.peek() != std::char_traits<char>::eof(),
-           source << ": Mat file has bytes after its " << width << "x" << height << "x"
-                  << channels << " payload");
+  return {static_cast<int>(width), static_cast<int>(height), static_cast<int>(channels)};
+}
+
+// The payload's size in bytes, and the errors for a payload of another size.
+std::streamsize PayloadBytes(const MatShape& shape) {
+  return static_cast<std::streamsize>(shape.width) * shape.height * shape.channels *
+         static_cast<std::streamsize>(sizeof(float));
+}
+void RequirePayloadBytes(const MatShape& shape, std::streamsize found, bool more_after,
+                         const std::string& source) {
+  THROW_IF(found < PayloadBytes(shape),
+           source << ": truncated Mat file: expected " << PayloadBytes(shape)
+                  << " bytes of data for " << shape.width << "x" << shape.height << "x"
+                  << shape.channels << ", found " << found);
+  THROW_IF(more_after, source << ": Mat file has bytes after its " << shape.width << "x"
+                              << shape.height << "x" << shape.channels << " payload");
+}
+
+std::ifstream OpenMat(const std::string& path) {
+  RequireFile(path, "Mat file");
+  std::ifstream in(path, std::ios::binary);
+  THROW_IF(!in, "Cannot open " << path);
+  return in;
+}
+
+}  // namespace
+
+FloatMap ReadMat(std::istream& in, const std::string& source) {
+  const MatShape shape = ReadMatHeader(in, source);
+  FloatMap map(shape.width, shape.height, shape.channels);
+  in.read(reinterpret_cast<char*>(map.Data().data()), PayloadBytes(shape));
+  // Before peek(), which resets gcount().
+  const std::streamsize found = in.gcount();
+  RequirePayloadBytes(shape, found,
+                      found == PayloadBytes(shape) && in.peek() != std::char_traits<char>::eof(),
+                      source);
   return map;
 }
 
 FloatMap ReadMat(const std::string& path) {
-  RequireFile(path, "Mat file");
-  std::ifstream in(path, std::ios::binary);
-  THROW_IF(!in, "Cannot open " << path);
+  std::ifstream in = OpenMat(path);
   return ReadMat(in, path);
+}
+
+MatShape ReadMatShape(const std::string& path) {
+  std::ifstream in = OpenMat(path);
+  const MatShape shape = ReadMatHeader(in, path);
+  const std::streamsize header_bytes = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamsize payload = static_cast<std::streamsize>(in.tellg()) - header_bytes;
+  RequirePayloadBytes(shape, std::min(payload, PayloadBytes(shape)),
+                      payload > PayloadBytes(shape), path);
+  return shape;
 }
 
 void WriteMat(std::ostream& out, const FloatMap& map) {

@@ -16,6 +16,15 @@ namespace hairmvs {
 // that is shorter or longer than W*H*C floats.
 FloatMap ReadMat(const std::string& path);
 FloatMap ReadMat(std::istream& in, const std::string& source);
+// The dimensions of the Mat file at `path`, from its header, checked against the file's size:
+// it throws as ReadMat would, but without reading the payload (to tell whether cached maps are
+// usable without loading them).
+struct MatShape {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+};
+MatShape ReadMatShape(const std::string& path);
 // Writes atomically (temporary name, then rename).
 void WriteMat(const std::string& path, const FloatMap& map);
 void WriteMat(std::ostream& out, const FloatMap& map);

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "colmap_ext/test_util.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 
@@ -45,6 +46,25 @@ TEST(MatIo, BadInput) {
   std::istringstream zero("0&4&1&");
   EXPECT_THROW(ReadMat(zero, "d.bin"), Error);
   EXPECT_THROW(ReadMat("/nonexistent/d.bin"), Error);
+}
+
+// ReadMatShape reads the header alone and fails, as ReadMat does, on a file of the wrong size.
+TEST(MatIo, ShapeFromTheHeaderCheckedAgainstTheFileSize) {
+  const std::string dir = testing_util::MakeTestDir("mat_shape");
+  const std::string path = JoinPaths(dir, "o.bin");
+  WriteMat(path, FloatMap(5, 3, 2, 0.5f));
+  const MatShape shape = ReadMatShape(path);
+  EXPECT_EQ(shape.width, 5);
+  EXPECT_EQ(shape.height, 3);
+  EXPECT_EQ(shape.channels, 2);
+  const std::string bytes = ReadTextFile(path);
+  for (const std::string& bad : {bytes.substr(0, bytes.size() - 1), bytes + "x"}) {
+    WriteFileAtomically(path, [&](std::ostream& out) { out << bad; });
+    const std::string shape_error = testing_util::ErrorOf([&] { ReadMatShape(path); });
+    EXPECT_EQ(shape_error, testing_util::ErrorOf([&] { ReadMat(path); }));
+    EXPECT_NE(shape_error, "(no error)");
+  }
+  EXPECT_NE(testing_util::ErrorOf([] { ReadMatShape("/nonexistent/o.bin"); }), "(no error)");
 }
 
 TEST(MatIo, CostVolumeRoundTripAndBadDepths) {

@@ -56,9 +56,9 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
   return out.str();
 }
 
-std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
-    const Workspace& workspace, const std::string& name, const std::string& provenance,
-    const StereoCamera& camera, int num_levels, std::string* why_not) {
+bool CachedOrientationFieldsHold(const Workspace& workspace, const std::string& name,
+                                 const std::string& provenance, const StereoCamera& camera,
+                                 int num_levels, std::string* why_not) {
   CHECK(why_not != nullptr);
   why_not->clear();
   const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
@@ -67,7 +67,7 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
       *why_not = "its cached orientation fields have no " + provenance_path +
                  " (written by an older hairmvs, or their writing was interrupted)";
     }
-    return std::nullopt;
+    return false;
   }
   const std::string cached = ReadTextFile(provenance_path);
   if (cached != provenance) {
@@ -83,34 +83,50 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     }
     *why_not = "its cached orientation fields were computed from other inputs (" +
                provenance_path + " says `" + was_line + "`, now `" + now_line + "`)";
-    return std::nullopt;
+    return false;
   }
-  std::vector<FloatMap> levels;
   for (int l = 0; l < num_levels; ++l) {
     const std::string path = workspace.OrientationMapPath(name, l);
     if (!ExistsFile(path)) {
       *why_not = "its cached orientation fields stop before level " + std::to_string(l) +
                  " (no " + path + ")";
-      return std::nullopt;
+      return false;
     }
-    FloatMap level;
+    MatShape shape;
     try {
-      level = ReadMat(path);
+      shape = ReadMatShape(path);  // the header and the file's size, not the payload
     } catch (const Error& e) {
       *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
-      return std::nullopt;
+      return false;
     }
     const StereoCamera level_camera = camera.PyramidLevel(l);
     const int width = level_camera.width, height = level_camera.height;
-    if (level.Width() != width || level.Height() != height || level.Channels() != 2) {
+    if (shape.width != width || shape.height != height || shape.channels != 2) {
       std::ostringstream message;
-      message << path << " is " << level.Width() << " x " << level.Height() << " x "
-              << level.Channels() << ", not the " << width << " x " << height
+      message << path << " is " << shape.width << " x " << shape.height << " x "
+              << shape.channels << ", not the " << width << " x " << height
               << " x 2 of its level";
       *why_not = message.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
+    const Workspace& workspace, const std::string& name, const std::string& provenance,
+    const StereoCamera& camera, int num_levels, std::string* why_not) {
+  if (!CachedOrientationFieldsHold(workspace, name, provenance, camera, num_levels, why_not)) {
+    return std::nullopt;
+  }
+  std::vector<FloatMap> levels;
+  for (int l = 0; l < num_levels; ++l) {
+    try {
+      levels.push_back(ReadMat(workspace.OrientationMapPath(name, l)));
+    } catch (const Error& e) {  // changed since the check (another process writing it)
+      *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
       return std::nullopt;
     }
-    levels.push_back(std::move(level));
   }
   return levels;
 }

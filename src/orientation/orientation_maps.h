@@ -24,11 +24,16 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
                                         int width, int height,
                                         const OrientationFieldOptions& options);
 
-// The cached levels [0, num_levels) of `name`, computed for `camera` (its size, and its
-// PyramidLevel(k)'s for level k), if its provenance file equals `provenance` and every level is
-// there, 2-channel and of its size. Otherwise nullopt, and `*why_not` says what differs (the
-// first line of the provenance that does not hold) or what is missing; it is left empty when
-// nothing of `name` is cached at all.
+// Whether the cached levels [0, num_levels) of `name` are those of `provenance` for `camera`
+// (its size, and its PyramidLevel(k)'s for level k): its provenance file equals `provenance` and
+// every level is there, 2-channel and of its size (the headers and file sizes are read, not
+// the payloads). If not, `*why_not` says what differs (the first line of the provenance that
+// does not hold) or what is missing; it is left empty when nothing of `name` is cached at all.
+bool CachedOrientationFieldsHold(const Workspace& workspace, const std::string& name,
+                                 const std::string& provenance, const StereoCamera& camera,
+                                 int num_levels, std::string* why_not);
+// The cached levels, where CachedOrientationFieldsHold; otherwise nullopt and `*why_not` as it
+// says.
 std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
     const StereoCamera& camera, int num_levels, std::string* why_not);

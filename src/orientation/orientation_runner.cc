@@ -107,9 +107,8 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
     if (run_options.skip_up_to_date) {
       std::string why_not;
-      bool up_to_date = ReadCachedOrientationFields(workspace, name, provenance, camera,
-                                                    options.num_levels, &why_not)
-                            .has_value();
+      bool up_to_date = CachedOrientationFieldsHold(workspace, name, provenance, camera,
+                                                    options.num_levels, &why_not);
       for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
         up_to_date = ExistsFile(PngPathFor(workspace.OrientationMapPath(name, l)));
       }

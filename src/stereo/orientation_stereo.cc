@@ -850,7 +850,7 @@ std::vector<ViewOutputs> WorkspaceOutputs(const std::string& workspace_path,
     const StereoCamera camera = workspace.ViewCamera(name).AtMaxImageSize(options.max_image_size);
     const std::string provenance =
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, field_options);
-    if (ReadCachedOrientationFields(workspace, name, provenance, camera, options.PyramidLevels(),
+    if (CachedOrientationFieldsHold(workspace, name, provenance, camera, options.PyramidLevels(),
                                     &view.why_stale)) {
       view.fields = ViewOutputs::Fields::kUpToDate;
     } else if (!view.why_stale.empty()) {
