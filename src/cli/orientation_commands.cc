@@ -40,8 +40,8 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
       "Computes the orientation field of each image (180-filter bank, 3 levels; Luo et al. "
       "2012, Section 2) and writes stereo/orientation_maps/<image name>.l<k>.bin (2-channel "
       "Mat: Re O, Im O) with <image name>.provenance.txt (its image, mask and filter options: the "
-      "stereo reuses the fields only while these hold), and with --write_png 1 a picture per level (hue = strand angle, "
-      "brightness = confidence).");
+      "stereo reuses the fields only while these hold), and with --write_png 1 a picture per "
+      "level (hue = strand angle, brightness = confidence).");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", true);
   parser.Add("image_names", &run_options.image_names, "comma-separated names (default: all)");
   parser.Add("mask_path", &run_options.mask_path,

@@ -110,7 +110,7 @@ GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_came
 }
 
 StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
-                          const std::string& name, int width, int height) {
+                        const std::string& name, int width, int height) {
   const std::string path = GroundTruthCamerasPath(gt_path);
   const int i = cameras.Find(name);
   THROW_IF(i < 0,
@@ -118,13 +118,13 @@ StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt
   THROW_IF(cameras.width != width || cameras.height != height,
            path << ": cameras of " << cameras.width << " x " << cameras.height << " px, but "
                 << GroundTruthViewPath(gt_path, name) << " is " << width << " x " << height);
-  StereoCamera grid;
-  grid.K = cameras.K;
-  grid.R = cameras.R[i];
-  grid.t = cameras.t[i];
-  grid.width = width;
-  grid.height = height;
-  return grid;
+  StereoCamera camera;
+  camera.K = cameras.K;
+  camera.R = cameras.R[i];
+  camera.t = cameras.t[i];
+  camera.width = width;
+  camera.height = height;
+  return camera;
 }
 
 }  // namespace hairmvs

@@ -60,7 +60,7 @@ GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_came
 // (DepthEvaluationOptions::in_true_cameras). Throws hairmvs::Error naming the file when the
 // camera is absent or of another size.
 StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
-                          const std::string& name, int width, int height);
+                        const std::string& name, int width, int height);
 
 // "Section.field" checks shared by the option structs.
 bool CheckImageNames(const std::vector<std::string>& names, std::string* error);
