@@ -19,14 +19,9 @@ constexpr char kNumLevelsOption[] = "OrientationField.num_levels";
 // "<bytes> bytes, crc32 <hex>" of the file at `path`.
 std::string Fingerprint(const std::string& path) {
   const std::string bytes = ReadTextFile(path);
-  uLong crc = crc32(0L, Z_NULL, 0);
-  // zlib takes lengths as uInt: feed the file in pieces that fit.
-  constexpr size_t kPiece = 1 << 30;
-  for (size_t offset = 0; offset < bytes.size(); offset += kPiece) {
-    const size_t length = std::min(kPiece, bytes.size() - offset);
-    crc = crc32(crc, reinterpret_cast<const Bytef*>(bytes.data() + offset),
-                static_cast<uInt>(length));
-  }
+  // crc32_z takes a size_t length (crc32's uInt would need the file fed in pieces).
+  const uLong crc = crc32_z(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()),
+                            bytes.size());
   char hex[9];
   std::snprintf(hex, sizeof(hex), "%08lx", crc);
   return std::to_string(bytes.size()) + " bytes, crc32 " + hex;
