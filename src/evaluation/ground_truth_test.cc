@@ -9,9 +9,9 @@
 #include <limits>
 #include <random>
 
-#include "colmap_ext/test_util.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 #include "src/evaluation/evaluation_util.h"
 
 namespace hairmvs {

@@ -14,11 +14,11 @@
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
 #include "colmap_ext/reconstruction.h"
-#include "colmap_ext/test_util.h"
 #include "hairmvs/evaluation.h"
 #include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 #include "src/evaluation/ground_truth.h"
 
 namespace hairmvs {

@@ -7,10 +7,10 @@
 #include <iterator>
 #include <set>
 
-#include "colmap_ext/test_util.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
 #include "src/core/npz.h"
+#include "src/core/test_util.h"
 #include "src/evaluation/ground_truth.h"
 
 namespace hairmvs {
