@@ -6,6 +6,7 @@
 #include <string>
 
 #include "src/cli/command_registry.h"
+#include "src/core/file_util.h"
 #include "src/core/logging.h"
 
 namespace hairmvs {
@@ -33,6 +34,7 @@ int PrintHelp() {
 
 int main(int argc, char** argv) {
   hairmvs::InitLogging(argv[0]);
+  hairmvs::RemoveTemporaryFilesOnInterrupt();
   if (argc < 2) {
     hairmvs::PrintHelp();
     return 1;

@@ -1,9 +1,12 @@
 #include "src/core/file_util.h"
 
+#include <limits.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -95,6 +98,53 @@ std::vector<std::string> SplitString(const std::string& s, const std::string& de
 
 namespace {
 
+// The temporary files of the atomic writes in flight, for the interrupt handler. Slots are
+// fixed buffers claimed with an atomic flag, so that the handler reads them without locks or
+// allocation (only async-signal-safe calls run there). A write that finds every slot taken is
+// simply not tracked: more than kNumSlots writes at once is far beyond this program's threads.
+constexpr int kNumSlots = 64;
+enum SlotState : int { kFree = 0, kClaimed = 1, kTracked = 2 };
+struct TemporarySlot {
+  std::atomic<int> state{kFree};
+  char path[PATH_MAX];
+};
+TemporarySlot temporary_slots[kNumSlots];
+
+// Tracks one temporary file from before it is created until it is renamed or removed.
+class TrackedTemporary {
+ public:
+  explicit TrackedTemporary(const std::string& tmp) {
+    if (tmp.size() >= PATH_MAX) return;
+    for (TemporarySlot& slot : temporary_slots) {
+      int expected = kFree;
+      if (slot.state.compare_exchange_strong(expected, kClaimed)) {
+        std::memcpy(slot.path, tmp.c_str(), tmp.size() + 1);
+        slot.state.store(kTracked);
+        slot_ = &slot;
+        return;
+      }
+    }
+  }
+  ~TrackedTemporary() {
+    if (slot_ != nullptr) slot_->state.store(kFree);
+  }
+  TrackedTemporary(const TrackedTemporary&) = delete;
+  TrackedTemporary& operator=(const TrackedTemporary&) = delete;
+
+ private:
+  TemporarySlot* slot_ = nullptr;
+};
+
+void RemoveTemporariesAndDie(int signal_number) {
+  for (TemporarySlot& slot : temporary_slots) {
+    // A name already renamed fails with ENOENT; names are unique to this process.
+    if (slot.state.load() == kTracked) unlink(slot.path);
+  }
+  // SA_RESETHAND restored the default action: the signal, delivered again once this handler
+  // returns, ends the process as it would have without the handler (exit status, core).
+  raise(signal_number);
+}
+
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
   const fs::path p(path);
@@ -120,6 +170,7 @@ void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool binary) {
   CreateDirs(ParentPath(path));
   const std::string tmp = TemporaryPathFor(path);
+  const TrackedTemporary tracked(tmp);
   try {
     std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
     // errno says why the stream failed (the folder not writable, the disk full).
@@ -140,6 +191,7 @@ void WritePathAtomically(const std::string& path,
                          const std::function<void(const std::string& tmp_path)>& write) {
   CreateDirs(ParentPath(path));
   const std::string tmp = TemporaryPathFor(path);
+  const TrackedTemporary tracked(tmp);
   try {
     write(tmp);
     THROW_IF(!ExistsFile(tmp), "Write failed for " << path);
@@ -149,6 +201,20 @@ void WritePathAtomically(const std::string& path,
     throw;
   }
   RenameOver(tmp, path);
+}
+
+void RemoveTemporaryFilesOnInterrupt() {
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    struct sigaction previous {};
+    sigaction(signal_number, nullptr, &previous);
+    // A signal the caller ignores (nohup's SIGHUP) stays ignored.
+    if (previous.sa_handler == SIG_IGN) continue;
+    struct sigaction action {};
+    action.sa_handler = RemoveTemporariesAndDie;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;
+    sigaction(signal_number, &action, nullptr);
+  }
 }
 
 }  // namespace hairmvs

@@ -42,4 +42,11 @@ void WriteFileAtomically(const std::string& path,
 void WritePathAtomically(const std::string& path,
                          const std::function<void(const std::string& tmp_path)>& write);
 
+// Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
+// temporary files of the writes above still in flight, then let the signal end the process as
+// it would have: a run stopped with Ctrl-C or by a cluster scheduler leaves no hidden
+// temporaries in the workspace, and every target is either its old or its new file.
+// The hairmvs binary calls it first thing.
+void RemoveTemporaryFilesOnInterrupt();
+
 }  // namespace hairmvs

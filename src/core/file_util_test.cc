@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
 
@@ -37,6 +39,57 @@ TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
     ++num_files;
   }
   EXPECT_EQ(num_files, 1);
+}
+
+int NumFilesIn(const std::string& dir) {
+  int num_files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++num_files;
+  }
+  return num_files;
+}
+
+// Interrupted in the middle of two nested writes (a stream and a named temporary), the process
+// dies of the signal, and both temporaries are gone while the old target is whole. Each case
+// runs in a child process (a death test), so the handlers do not stay installed here.
+TEST(FileUtil, InterruptRemovesTemporariesInFlight) {
+  const std::string dir = TestDir("interrupt");
+  const std::string kept = JoinPaths(dir, "kept.txt");
+  const std::string named = JoinPaths(dir, "named.png");
+  WriteFileAtomically(kept, [](std::ostream& out) { out << "old"; });
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+    EXPECT_EXIT(
+        {
+          RemoveTemporaryFilesOnInterrupt();
+          WriteFileAtomically(kept, [&](std::ostream& out) {
+            out << "half" << std::flush;
+            WritePathAtomically(named, [&](const std::string& tmp_path) {
+              WriteFileAtomically(tmp_path, [](std::ostream& o) { o << "x"; });
+              // kept.txt, its temporary, the named temporary and the latter's own one
+              // (renamed over it already): 3 files, so both writes are in flight.
+              if (NumFilesIn(dir) != 3) std::_Exit(3);
+              std::raise(signal_number);
+            });
+          });
+          std::_Exit(4);  // not reached: the signal ends the process
+        },
+        ::testing::KilledBySignal(signal_number), "");
+    EXPECT_EQ(NumFilesIn(dir), 1) << "signal " << signal_number;
+    EXPECT_EQ(ReadTextFile(kept), "old");
+  }
+}
+
+// A signal the caller ignores (nohup's SIGHUP) stays ignored.
+TEST(FileUtil, InterruptHandlersLeaveIgnoredSignalsIgnored) {
+  EXPECT_EXIT(
+      {
+        std::signal(SIGHUP, SIG_IGN);
+        RemoveTemporaryFilesOnInterrupt();
+        std::raise(SIGHUP);
+        std::_Exit(0);
+      },
+      ::testing::ExitedWithCode(0), "");
 }
 
 // A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
