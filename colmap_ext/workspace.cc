@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "src/core/file_util.h"
@@ -262,6 +263,17 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     cv::bitwise_or(keep, nonzero, keep);
   }
   if (keep.cols != width || keep.rows != height) {
+    // A mask of another size is taken as the same picture at another scale (COLMAP's fusion
+    // rescales masks too). Another aspect ratio cannot line up with the image, e.g. a mask
+    // drawn on a photo before colmap image_undistorter changed its size: an error, not a
+    // silently shifted mask. One pixel of rounding is allowed each way.
+    const double height_at_width = static_cast<double>(keep.rows) * width / keep.cols;
+    const double width_at_height = static_cast<double>(keep.cols) * height / keep.rows;
+    THROW_IF(std::abs(height_at_width - height) > 1 && std::abs(width_at_height - width) > 1,
+             "Mask " << path << " is " << keep.cols << " x " << keep.rows
+                     << ", another aspect ratio than its image's (read at " << width << " x "
+                     << height << "): draw masks on the images in the workspace's images/, "
+                        "as colmap image_undistorter wrote them");
     cv::Mat resized;
     cv::resize(keep, resized, cv::Size(width, height), 0, 0, cv::INTER_NEAREST);
     keep = resized;

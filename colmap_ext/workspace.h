@@ -78,8 +78,9 @@ class Workspace {
 FloatMap ReadImageGray(const std::string& path);
 // RGB in [0, 1], 3 channels (R, G, B planes).
 FloatMap ReadImageRgb(const std::string& path);
-// A mask resized to width x height (nearest); 1 = keep, 0 = excluded. An all-zero mask is an
-// error naming the file. Returns a map of ones if `path` is empty.
+// A mask resized to width x height (nearest); 1 = keep, 0 = excluded. An all-zero mask, or
+// one of another aspect ratio than width x height (beyond a pixel's rounding), is an error
+// naming the file. Returns a map of ones if `path` is empty.
 FloatMap ReadMask(const std::string& path, int width, int height);
 // Writes a 1- or 3-channel (R, G, B) map with values in [0, 1] as an 8-bit image (format from
 // the extension, e.g. .png), atomically. Values are clamped and rounded.

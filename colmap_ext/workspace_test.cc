@@ -149,7 +149,7 @@ TEST(Images, GrayRgbAndSixteenBit) {
             std::string::npos);
 }
 
-TEST(Images, MaskResizedNearestAndAllZeroIsAnError) {
+TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
   const std::string dir = MakeTestDir("masks");
   cv::Mat mask(2, 2, CV_8U, cv::Scalar(0));
   mask.at<uint8_t>(0, 1) = 255;
@@ -165,6 +165,16 @@ TEST(Images, MaskResizedNearestAndAllZeroIsAnError) {
   const std::string zero = JoinPaths(dir, "zero.png");
   ASSERT_TRUE(cv::imwrite(zero, cv::Mat(3, 3, CV_8U, cv::Scalar(0))));
   EXPECT_NE(ErrorOf([&] { ReadMask(zero, 3, 3); }).find("zero.png"), std::string::npos);
+  // Scaled copies are read, with a pixel of rounding (960 x 640 at 160 px wide is 106.7 rows);
+  // another aspect ratio is named with both sizes.
+  const std::string wide = JoinPaths(dir, "wide.png");
+  ASSERT_TRUE(cv::imwrite(wide, cv::Mat(640, 960, CV_8U, cv::Scalar(255))));
+  EXPECT_EQ(ReadMask(wide, 160, 107).Width(), 160);
+  EXPECT_EQ(ReadMask(wide, 160, 106).Height(), 106);
+  const std::string error = ErrorOf([&] { ReadMask(wide, 600, 450); });
+  EXPECT_NE(error.find("wide.png is 960 x 640"), std::string::npos) << error;
+  EXPECT_NE(error.find("600 x 450"), std::string::npos) << error;
+  EXPECT_NE(ErrorOf([&] { ReadMask(wide, 160, 110); }).find("aspect ratio"), std::string::npos);
 }
 
 }  // namespace
