@@ -327,33 +327,52 @@ void WriteNpz(const std::string& path, const std::map<std::string, NpyArray>& ar
     WriteFileAtomically(path, [&](std::ostream& out) { out << empty_zip; });
     return;
   }
-  WritePathAtomically(path, [&](const std::string& tmp_path) {
-    int error_code = 0;
-    zip_t* archive = zip_open(tmp_path.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &error_code);
-    THROW_IF(archive == nullptr,
-             "Cannot create " << path << ": " << ZipErrorString(error_code));
-    size_t k = 0;
-    for (const auto& [key, array] : arrays) {
-      const std::string& bytes = buffers[k++];
-      zip_source_t* source = zip_source_buffer(archive, bytes.data(), bytes.size(), 0);
-      const zip_int64_t index =
-          source == nullptr ? -1
-                            : zip_file_add(archive, (key + ".npy").c_str(), source,
-                                           ZIP_FL_ENC_UTF_8 | ZIP_FL_OVERWRITE);
-      if (index < 0) {
-        if (source != nullptr) zip_source_free(source);
-        const std::string message = zip_strerror(archive);
-        zip_discard(archive);
-        HAIRMVS_THROW("Cannot add " << key << ".npy to " << path << ": " << message);
-      }
-      zip_set_file_compression(archive, index, ZIP_CM_DEFLATE, 6);
-    }
-    if (zip_close(archive) != 0) {
+  // The archive is made in memory and written like every other file: libzip writing a file
+  // itself would make a temporary of its own, which an interrupt would leave behind.
+  zip_error_t error;
+  zip_error_init(&error);
+  zip_source_t* memory = zip_source_buffer_create(nullptr, 0, 0, &error);
+  THROW_IF(memory == nullptr, "Cannot create " << path << ": " << zip_error_strerror(&error));
+  std::unique_ptr<zip_source_t, void (*)(zip_source_t*)> memory_guard(memory, zip_source_free);
+  zip_t* archive = zip_open_from_source(memory, ZIP_TRUNCATE, &error);
+  THROW_IF(archive == nullptr, "Cannot create " << path << ": " << zip_error_strerror(&error));
+  zip_source_keep(memory);  // the archive's close must not free it: its bytes are read after
+  size_t k = 0;
+  for (const auto& [key, array] : arrays) {
+    const std::string& bytes = buffers[k++];
+    zip_source_t* source = zip_source_buffer(archive, bytes.data(), bytes.size(), 0);
+    const zip_int64_t index =
+        source == nullptr ? -1
+                          : zip_file_add(archive, (key + ".npy").c_str(), source,
+                                         ZIP_FL_ENC_UTF_8 | ZIP_FL_OVERWRITE);
+    if (index < 0) {
+      if (source != nullptr) zip_source_free(source);
       const std::string message = zip_strerror(archive);
       zip_discard(archive);
-      HAIRMVS_THROW("Cannot write " << path << ": " << message);
+      HAIRMVS_THROW("Cannot add " << key << ".npy to " << path << ": " << message);
     }
-  });
+    zip_set_file_compression(archive, index, ZIP_CM_DEFLATE, 6);
+  }
+  if (zip_close(archive) != 0) {
+    const std::string message = zip_strerror(archive);
+    zip_discard(archive);
+    HAIRMVS_THROW("Cannot write " << path << ": " << message);
+  }
+  std::string zipped;
+  bool read = zip_source_open(memory) == 0;
+  if (read) {
+    read = zip_source_seek(memory, 0, SEEK_END) == 0;
+    const zip_int64_t size = read ? zip_source_tell(memory) : -1;
+    read = size > 0 && zip_source_seek(memory, 0, SEEK_SET) == 0;
+    if (read) {
+      zipped.resize(static_cast<size_t>(size));
+      read = zip_source_read(memory, zipped.data(), size) == size;
+    }
+    zip_source_close(memory);
+  }
+  THROW_IF(!read, "Cannot write " << path << ": " << zip_error_strerror(zip_source_error(memory)));
+  WriteFileAtomically(path,
+                      [&zipped](std::ostream& out) { out.write(zipped.data(), zipped.size()); });
 }
 
 const NpyArray& NpzEntry(const std::map<std::string, NpyArray>& arrays, const std::string& key,
