@@ -3,12 +3,11 @@
 
 #include <cstdio>
 #include <algorithm>
-#include <cstdlib>
 #include <memory>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/image_undistorter.h"
 #include "colmap_ext/source_views.h"
 #include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
@@ -34,38 +33,11 @@ bool HasStage(const std::vector<std::string>& stages, const std::string& stage) 
   return false;
 }
 
-// Quotes a path for /bin/sh.
-std::string ShellQuote(const std::string& text) {
-  std::string quoted = "'";
-  for (char c : text) {
-    if (c == '\'') quoted += "'\\''";
-    else quoted += c;
-  }
-  return quoted + "'";
-}
-
-// Runs `colmap image_undistorter` so that `workspace_path` becomes a COLMAP dense workspace.
-void RunImageUndistorter(const std::string& colmap, const std::string& image_path,
-                         const std::string& input_path, const std::string& workspace_path) {
-  RequireDir(image_path, "image folder (--image_path)");
-  RequireDir(input_path, "sparse model folder (--input_path)");
-  CreateDirs(workspace_path);
-  const std::string command = "QT_QPA_PLATFORM=offscreen " + ShellQuote(colmap) +
-                              " image_undistorter --image_path " + ShellQuote(image_path) +
-                              " --input_path " + ShellQuote(input_path) + " --output_path " +
-                              ShellQuote(workspace_path) + " --output_type COLMAP";
-  std::fprintf(stderr, "[pipeline] %s\n", command.c_str());
-  const int status = std::system(command.c_str());
-  THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
-                            << status << ") for --image_path " << image_path
-                            << " --input_path " << input_path
-                            << "; is COLMAP installed (apt-get install colmap)?");
-}
-
 int RunPipeline(int argc, char** argv) {
   std::string workspace_path;
   std::string image_path;
   std::string input_path;
+  std::string photo_mask_path;
   std::string ground_truth_path;
   std::string colmap_executable = "colmap";
   std::vector<std::string> image_names;
@@ -85,6 +57,9 @@ int RunPipeline(int argc, char** argv) {
   parser.Add("image_path", &image_path, "your photos (only to create the workspace)");
   parser.Add("input_path", &input_path,
              "sparse model from colmap mapper (only to create the workspace)");
+  parser.Add("mask_path", &photo_mask_path,
+             "masks of your photos (<photo name>.png, 0 = excluded), undistorted with them into "
+             "the new workspace's masks/ (only to create the workspace)");
   parser.Add("colmap_executable", &colmap_executable, "colmap binary for image_undistorter");
   parser.Add("image_names", &image_names,
              "reference views to process (comma-separated; empty = all). With a subset, the "
@@ -118,7 +93,20 @@ int RunPipeline(int argc, char** argv) {
                                              << "); give --image_path and --input_path to "
                                                 "create it with colmap image_undistorter");
     ScopedStageTimer timer(&timings, "image_undistorter");
+    if (!photo_mask_path.empty()) RequireDir(photo_mask_path, "mask folder (--mask_path)");
     RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
+    if (!photo_mask_path.empty()) {
+      const MaskUndistortionResult masks =
+          UndistortMasks(colmap_executable, photo_mask_path, input_path, workspace_path);
+      std::fprintf(stderr, "[pipeline] undistorted %d mask(s) of %s into %s/masks\n",
+                   masks.num_masks, photo_mask_path.c_str(), workspace_path.c_str());
+    }
+  } else {
+    THROW_IF(!photo_mask_path.empty(),
+             "--mask_path " << photo_mask_path << " holds masks of the photos, undistorted only "
+                            << "when the workspace is created; " << workspace_path
+                            << " exists: put masks drawn on its images in " << workspace_path
+                            << "/masks");
   }
 
   if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {

@@ -3,6 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -10,6 +14,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "colmap_ext/image_undistorter.h"
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
 #include "colmap_ext/reconstruction.h"
@@ -22,6 +27,7 @@
 namespace hairmvs {
 namespace {
 
+using testing_util::ErrorOf;
 using testing_util::ExpectModelsEqual;
 using testing_util::MakePlaneModel;
 using testing_util::MakeTestDir;
@@ -198,6 +204,87 @@ TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
   WriteFusedPly(ours, points);
   EXPECT_EQ(ReadTextFile(ours), ReadTextFile(fused));
   EXPECT_EQ(ReadTextFile(ours + ".vis"), ReadTextFile(fused + ".vis"));
+}
+
+// Masks drawn on distorted photos are undistorted as the photos are: the written mask matches
+// the undistorted photo's own content pixel for pixel (but its rim), where the photo's mask
+// merely resized to the new size does not. A photo without a mask gets none; a mask of another
+// aspect ratio is named.
+TEST(ColmapInterop, UndistortMasksAsThePhotos) {
+  REQUIRE_COLMAP();
+  const std::string dir = MakeTestDir("interop_undistort_masks");
+  const int width = 320, height = 240;
+  // Bright discs on a dark ground, so that a photo's content is its own mask.
+  cv::Mat photo(height, width, CV_8UC3, cv::Scalar(20, 30, 40));
+  for (int row = 0; row < 5; ++row) {
+    for (int col = 0; col < 7; ++col) {
+      cv::circle(photo, cv::Point(20 + 46 * col, 20 + 50 * row), 14, cv::Scalar(230, 220, 210),
+                 cv::FILLED);
+    }
+  }
+  cv::Mat photo_mask;
+  cv::cvtColor(photo, photo_mask, cv::COLOR_BGR2GRAY);
+  cv::threshold(photo_mask, photo_mask, 127, 255, cv::THRESH_BINARY);
+  const std::string photos = JoinPaths(dir, "photos"), masks = JoinPaths(dir, "photo_masks");
+  CreateDirs(photos);
+  CreateDirs(masks);
+  Reconstruction model = MakePlaneModel();  // a.png, b.png, c.png
+  model.images.at(1).name = "a.jpg";        // masks are <photo name>.png whatever the format
+  for (auto& [id, camera] : model.cameras) {
+    camera.model_id = CameraModelByName("OPENCV").id;
+    camera.width = width;
+    camera.height = height;
+    camera.params = {200, 200, width / 2.0, height / 2.0, -0.3, 0.05, 0.001, -0.001};
+  }
+  for (const auto& [id, image] : model.images) {
+    ASSERT_TRUE(cv::imwrite(JoinPaths(photos, image.name), photo));
+  }
+  ASSERT_TRUE(cv::imwrite(JoinPaths(masks, "a.jpg.png"), photo_mask));
+  cv::Mat mask_with_ones;  // keep = 1, not 255: any non-zero value keeps, as in COLMAP
+  photo_mask.convertTo(mask_with_ones, CV_8U, 1.0 / 255);
+  ASSERT_TRUE(cv::imwrite(JoinPaths(masks, "b.png.png"), mask_with_ones));
+  const std::string sparse = JoinPaths(dir, "sparse");
+  CreateDirs(sparse);
+  WriteReconstruction(model, sparse, ModelFormat::kText);
+
+  const std::string workspace_path = JoinPaths(dir, "dense");
+  RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace_path);
+  const MaskUndistortionResult result =
+      UndistortMasks(ColmapExecutable(), masks, sparse, workspace_path);
+  EXPECT_EQ(result.num_masks, 2);
+  EXPECT_EQ(result.images_without_mask, std::vector<std::string>{"c.png"});
+
+  const Workspace ws = Workspace::Read(workspace_path);
+  EXPECT_EQ(ws.ImagesWithoutMask(), std::vector<std::string>{"c.png"});
+  for (const std::string name : {"a.jpg", "b.png"}) {
+    const Camera& camera = ws.CameraOf(name);
+    ASSERT_TRUE(camera.IsPinhole());
+    ASSERT_NE(static_cast<int>(camera.width), width) << "the undistorter kept the size";
+    const cv::Mat mask = cv::imread(ws.MaskPath(name), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(mask.cols, static_cast<int>(camera.width));
+    ASSERT_EQ(mask.rows, static_cast<int>(camera.height));
+    ASSERT_EQ(mask.type(), CV_8U);
+    cv::Mat content;
+    cv::cvtColor(cv::imread(ws.ImagePath(name)), content, cv::COLOR_BGR2GRAY);
+    cv::threshold(content, content, 127, 255, cv::THRESH_BINARY);
+    cv::Mat resized;
+    cv::resize(photo_mask, resized, mask.size(), 0, 0, cv::INTER_NEAREST);
+    const double n = static_cast<double>(mask.total());
+    const double agree = cv::countNonZero(mask == content) / n;
+    const double agree_resized = cv::countNonZero(resized == content) / n;
+    EXPECT_GT(agree, 0.995) << name;
+    EXPECT_LT(agree_resized, 0.95) << name << ": the distortion should matter in this test";
+    RecordProperty(std::string("agreement_") + name, Format(agree));
+    RecordProperty(std::string("agreement_resized_") + name, Format(agree_resized));
+  }
+
+  cv::Mat narrow;
+  cv::resize(photo_mask, narrow, cv::Size(width, height / 2));
+  ASSERT_TRUE(cv::imwrite(JoinPaths(masks, "c.png.png"), narrow));
+  const std::string error =
+      ErrorOf([&] { UndistortMasks(ColmapExecutable(), masks, sparse, workspace_path); });
+  EXPECT_NE(error.find("c.png.png"), std::string::npos) << error;
+  EXPECT_NE(error.find("aspect ratio"), std::string::npos) << error;
 }
 
 TEST(ColmapInterop, PoissonMesherAcceptsOurFusedPly) {

@@ -1,0 +1,34 @@
+#pragma once
+// `colmap image_undistorter`, run for hairmvs: a dense workspace made from a user's photos,
+// and the masks of those photos undistorted exactly as the photos were.
+
+#include <string>
+#include <vector>
+
+namespace hairmvs {
+
+// Runs `colmap image_undistorter --output_type COLMAP` (COLMAP's defaults otherwise), so that
+// `workspace_path` becomes the dense workspace of the photos in `image_path` and the model in
+// `input_path`. Throws hairmvs::Error naming the folders and the exit status.
+void RunImageUndistorter(const std::string& colmap_executable, const std::string& image_path,
+                         const std::string& input_path, const std::string& workspace_path);
+
+struct MaskUndistortionResult {
+  int num_masks = 0;                             // written to workspace_path/masks
+  std::vector<std::string> images_without_mask;  // photos that have no mask in mask_path
+};
+
+// Masks drawn on the photos (`mask_path`/<photo name>.png, 0 = excluded, COLMAP's naming) do
+// not line up with the undistorted images, whose size and pixels the undistorter changed. This
+// runs `colmap image_undistorter` again on the masks, binarised and with the same options as
+// RunImageUndistorter, in a folder under the system's temporary directory, and writes each
+// result, thresholded at half (the undistorter interpolates), as
+// `workspace_path`/masks/<image name>.png. Call it after RunImageUndistorter made the workspace.
+// Throws hairmvs::Error naming the mask for one that is empty or of another aspect ratio than
+// its photo (ReadMask's rules), and the folders if the undistorter fails.
+MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
+                                      const std::string& mask_path,
+                                      const std::string& input_path,
+                                      const std::string& workspace_path);
+
+}  // namespace hairmvs
