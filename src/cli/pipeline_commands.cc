@@ -184,14 +184,26 @@ int RunPipeline(int argc, char** argv) {
   std::printf("%s", timings.Table("hairmvs pipeline: time per stage").c_str());
   std::printf("peak memory: %.0f MiB, wall time: %.1f s\n", PeakResidentMemoryMiB(),
               total.ElapsedSeconds());
-  std::printf(
-      "Look at:\n"
-      "  %s/stereo/orientation_maps/*.png   orientation fields (hue = strand angle)\n"
-      "  %s/stereo/depth_maps/*.png, normal_maps/*.png   depth and normal pictures\n"
-      "  %s/stereo/evaluation/*.png   error pictures (with --ground_truth_path)\n"
-      "  %s/meshed-hair.ply   the hair surface (MeshLab, or COLMAP's GUI with sparse/)\n",
-      workspace_path.c_str(), workspace_path.c_str(), workspace_path.c_str(),
-      workspace_path.c_str());
+  // What this run wrote, to look at.
+  const char* w = workspace_path.c_str();
+  std::printf("Look at:\n");
+  if (write_png && HasStage(stages, "orientation")) {
+    std::printf("  %s/stereo/orientation_maps/*.png   orientation fields (hue = strand angle)\n",
+                w);
+  }
+  if (write_png && HasStage(stages, "stereo")) {
+    std::printf("  %s/stereo/depth_maps/*.png, normal_maps/*.png   depth and normal pictures\n", w);
+  }
+  if (HasStage(stages, "stereo")) {
+    std::printf("  %s/stereo/depth_maps/*.geometric.bin   for colmap stereo_fusion\n", w);
+  }
+  if (!ground_truth_path.empty()) {
+    std::printf("  %s/stereo/evaluation/*.png   error pictures\n", w);
+  }
+  if (HasStage(stages, "fusion") && image_names.empty()) {
+    std::printf("  %s/fused.ply, %s/meshed-hair.ply   the fused points and the hair surface "
+                "(MeshLab, or COLMAP's GUI with sparse/)\n", w, w);
+  }
   return 0;
 }
 
