@@ -49,11 +49,16 @@ WorkspaceInfo ComputeWorkspaceInfo(const std::string& workspace_path,
     row.mask_path = ws.MaskPath(name);
     if (!row.mask_path.empty()) {
       const Camera& camera = model.cameras.at(image.camera_id);
-      const FloatMap mask = ReadMask(row.mask_path, static_cast<int>(camera.width),
-                                     static_cast<int>(camera.height));
-      double kept = 0;
-      for (float v : mask.Data()) kept += v;
-      row.mask_keep_fraction = kept / static_cast<double>(mask.NumPixels());
+      // A report lists an unusable mask (the stereo stops on it) rather than stopping itself.
+      try {
+        const FloatMap mask = ReadMask(row.mask_path, static_cast<int>(camera.width),
+                                       static_cast<int>(camera.height));
+        double kept = 0;
+        for (float v : mask.Data()) kept += v;
+        row.mask_keep_fraction = kept / static_cast<double>(mask.NumPixels());
+      } catch (const Error& e) {
+        row.mask_error = e.what();
+      }
     }
     if (options.depth_min > 0 && options.depth_max > 0) {
       row.depth_range = DepthRangeFor(ws, name, options);
@@ -82,6 +87,8 @@ std::string WorkspaceInfo::Report() const {
         << " cam " << v.camera_id << " " << v.num_points2D << "/" << v.num_points3D << " ";
     if (v.mask_path.empty()) {
       out << "no-mask";
+    } else if (!v.mask_error.empty()) {
+      out << "mask UNUSABLE";
     } else {
       out << "mask " << std::fixed << std::setprecision(3) << v.mask_keep_fraction;
     }
@@ -94,6 +101,9 @@ std::string WorkspaceInfo::Report() const {
     }
     out.unsetf(std::ios::fixed);
     out << std::setprecision(6) << "\n";
+  }
+  for (const WorkspaceInfoViewRow& v : views) {
+    if (!v.mask_error.empty()) out << "Unusable mask: " << v.mask_error << "\n";
   }
   out << "Source views (" << selections.size() << " references, " << num_t_groups
       << " gantry T groups):\n";

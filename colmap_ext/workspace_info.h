@@ -17,7 +17,8 @@ struct WorkspaceInfoViewRow {
   int num_points2D = 0;
   int num_points3D = 0;  // observations with a 3D point
   std::string mask_path;  // "" = none
-  double mask_keep_fraction = -1;  // share of pixels the mask keeps; -1 = no mask
+  double mask_keep_fraction = -1;  // share of pixels the mask keeps; -1 = no mask or unusable
+  std::string mask_error;  // why the mask cannot be used (all zero, another aspect ratio)
   DepthRange depth_range;
 };
 

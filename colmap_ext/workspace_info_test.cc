@@ -35,6 +35,19 @@ TEST(WorkspaceInfo, SyntheticWorkspace) {
                            "mask 0.500", "workspace_info took"}) {
     EXPECT_NE(report.find(part), std::string::npos) << part << "\n" << report;
   }
+
+  // Unusable masks are listed with the reason, not a stop of the report.
+  ASSERT_TRUE(cv::imwrite(JoinPaths(dir, "masks", "b.png.png"), cv::Mat(48, 64, CV_8U, 0.0)));
+  ASSERT_TRUE(cv::imwrite(JoinPaths(dir, "masks", "c.png.png"), cv::Mat(20, 64, CV_8U, 255.0)));
+  const WorkspaceInfo bad = ComputeWorkspaceInfo(dir, "", SourceViewOptions());
+  EXPECT_TRUE(bad.views[0].mask_error.empty());
+  EXPECT_NE(bad.views[1].mask_error.find("excludes every pixel"), std::string::npos);
+  EXPECT_NE(bad.views[2].mask_error.find("aspect ratio"), std::string::npos);
+  EXPECT_EQ(bad.views[2].mask_keep_fraction, -1);
+  const std::string bad_report = bad.Report();
+  for (const char* part : {"mask UNUSABLE", "Unusable mask: Mask ", "c.png.png is 64 x 20"}) {
+    EXPECT_NE(bad_report.find(part), std::string::npos) << part << "\n" << bad_report;
+  }
 }
 
 TEST(WorkspaceInfo, SharedGantrySetHasEightTGroups) {
