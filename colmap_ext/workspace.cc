@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include "src/core/file_util.h"
@@ -186,10 +187,39 @@ std::string Workspace::OrientationMapProvenancePath(const std::string& name) con
 
 namespace {
 
+// Whether a JPEG stream's end-of-image marker follows its last start-of-scan marker. libjpeg
+// decodes a truncated file without an error, filling what is missing with grey (OpenCV only
+// prints "Premature end of JPEG file"). Neither marker occurs inside entropy-coded data (0xFF
+// is stuffed there), and an embedded EXIF thumbnail's markers come before the main image's,
+// so the last of each belongs to the main image; bytes a camera appends after it are allowed.
+bool JpegIsComplete(const std::string& bytes) {
+  size_t last_scan = std::string::npos, last_end = std::string::npos;
+  for (size_t i = 0; i + 1 < bytes.size(); ++i) {
+    if (static_cast<uint8_t>(bytes[i]) != 0xFF) continue;
+    const uint8_t marker = static_cast<uint8_t>(bytes[i + 1]);
+    if (marker == 0xDA) last_scan = i;
+    if (marker == 0xD9) last_end = i;
+  }
+  return last_scan != std::string::npos && last_end != std::string::npos && last_end > last_scan;
+}
+
 cv::Mat ReadUnchanged(const std::string& path, const char* what) {
   RequireFile(path, what);
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  THROW_IF(image.empty(), "Cannot decode " << what << " " << path);
+  const std::string bytes = ReadTextFile(path);
+  cv::Mat image;
+  if (!bytes.empty()) {
+    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
+                                 const_cast<char*>(bytes.data())),
+                         cv::IMREAD_UNCHANGED);
+  }
+  THROW_IF(image.empty(), "Cannot decode " << what << " " << path << " (" << bytes.size()
+                                           << " bytes): truncated, or not an image format "
+                                              "OpenCV reads");
+  const bool jpeg = bytes.size() >= 2 && static_cast<uint8_t>(bytes[0]) == 0xFF &&
+                    static_cast<uint8_t>(bytes[1]) == 0xD8;
+  THROW_IF(jpeg && !JpegIsComplete(bytes),
+           "Truncated " << what << " " << path << " (" << bytes.size()
+                        << " bytes): the JPEG data ends before its end-of-image marker");
   return image;
 }
 

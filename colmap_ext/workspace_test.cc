@@ -149,6 +149,38 @@ TEST(Images, GrayRgbAndSixteenBit) {
             std::string::npos);
 }
 
+// A truncated file is an error naming it: libpng fails, and libjpeg would decode the part
+// that is there (the rest grey) but for the check of the end-of-image marker. Bytes a camera
+// appends after the image are allowed.
+TEST(Images, TruncatedImagesAreErrors) {
+  const std::string dir = MakeTestDir("truncated");
+  cv::Mat noise(48, 64, CV_8UC3);
+  cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
+  for (const std::string extension : {".jpg", ".png"}) {
+    const std::string whole = JoinPaths(dir, "whole" + extension);
+    ASSERT_TRUE(cv::imwrite(whole, noise));
+    EXPECT_EQ(ReadImageRgb(whole).Width(), 64);
+    const std::string bytes = ReadTextFile(whole);
+    const std::string cut = JoinPaths(dir, "cut" + extension);
+    WriteFileAtomically(cut, [&](std::ostream& out) { out << bytes.substr(0, bytes.size() / 2); });
+    const std::string error = ErrorOf([&] { ReadImageGray(cut); });
+    EXPECT_NE(error.find(cut), std::string::npos) << error;
+    EXPECT_NE(error.find(extension == ".jpg" ? "Truncated image" : "truncated"),
+              std::string::npos)
+        << error;
+    EXPECT_NE(error.find(std::to_string(bytes.size() / 2) + " bytes"), std::string::npos)
+        << error;
+  }
+  const std::string trailer = JoinPaths(dir, "trailer.jpg");
+  WriteFileAtomically(trailer, [&](std::ostream& out) {
+    out << ReadTextFile(JoinPaths(dir, "whole.jpg")) << "appended by a camera";
+  });
+  EXPECT_EQ(ReadImageGray(trailer).Height(), 48);
+  const std::string empty = JoinPaths(dir, "empty.png");
+  WriteFileAtomically(empty, [](std::ostream&) {});
+  EXPECT_NE(ErrorOf([&] { ReadMask(empty, 4, 4); }).find("Cannot decode mask"), std::string::npos);
+}
+
 TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
   const std::string dir = MakeTestDir("masks");
   cv::Mat mask(2, 2, CV_8U, cv::Scalar(0));
