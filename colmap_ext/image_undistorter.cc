@@ -90,7 +90,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,
                                       const std::string& workspace_path) {
-  RequireDir(mask_path, "mask folder (--mask_path)");
+  RequireDir(mask_path, "mask folder of the photos");
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
   const Workspace workspace = Workspace::Read(workspace_path, mask_path);

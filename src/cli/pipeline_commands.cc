@@ -57,7 +57,7 @@ int RunPipeline(int argc, char** argv) {
   parser.Add("image_path", &image_path, "your photos (only to create the workspace)");
   parser.Add("input_path", &input_path,
              "sparse model from colmap mapper (only to create the workspace)");
-  parser.Add("mask_path", &photo_mask_path,
+  parser.Add("photo_mask_path", &photo_mask_path,
              "masks of your photos (<photo name>.png, 0 = excluded), undistorted with them into "
              "the new workspace's masks/ (only to create the workspace)");
   parser.Add("colmap_executable", &colmap_executable, "colmap binary for image_undistorter");
@@ -93,7 +93,9 @@ int RunPipeline(int argc, char** argv) {
                                              << "); give --image_path and --input_path to "
                                                 "create it with colmap image_undistorter");
     ScopedStageTimer timer(&timings, "image_undistorter");
-    if (!photo_mask_path.empty()) RequireDir(photo_mask_path, "mask folder (--mask_path)");
+    if (!photo_mask_path.empty()) {
+      RequireDir(photo_mask_path, "mask folder (--photo_mask_path)");
+    }
     RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
     if (!photo_mask_path.empty()) {
       const MaskUndistortionResult masks =
@@ -103,10 +105,11 @@ int RunPipeline(int argc, char** argv) {
     }
   } else {
     THROW_IF(!photo_mask_path.empty(),
-             "--mask_path " << photo_mask_path << " holds masks of the photos, undistorted only "
-                            << "when the workspace is created; " << workspace_path
-                            << " exists: put masks drawn on its images in " << workspace_path
-                            << "/masks");
+             "--photo_mask_path " << photo_mask_path
+                 << " holds masks of the photos, undistorted only when the workspace is "
+                    "created; "
+                 << workspace_path << " exists: put masks drawn on its images in "
+                 << workspace_path << "/masks");
   }
 
   if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {
