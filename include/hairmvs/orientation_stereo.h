@@ -64,6 +64,10 @@ bool FromString(const std::string& text, VisualHullBound* bound);
 
 struct OrientationStereoOptions {
   StereoCost cost = StereoCost::kOrientation;
+  // The masks' folder, <mask_path>/<image name>.png as COLMAP's StereoFusion.mask_path names
+  // them (empty: <workspace>/masks when it exists). The views' cached orientation fields are
+  // reused only if they were computed with these masks.
+  std::string mask_path;
   // Processing resolution: the longer image side is downscaled to at most this (-1: full size).
   // Depth maps are then smaller than the images, as COLMAP's are.
   int max_image_size = -1;
@@ -423,6 +427,8 @@ struct OrientationStereoOptions {
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
     v("cost", &cost, "orientation|photometric|combined: what is matched");
+    v("mask_path", &mask_path,
+      "folder of masks <image name>.png (empty: <workspace>/masks if present)");
     v("max_image_size", &max_image_size, "longer side of the processing resolution (-1: full)");
     v("depth_min", &depth_min, "depth range start in metres (<= 0: from the sparse points)");
     v("depth_max", &depth_max, "depth range end in metres (<= 0: from the sparse points)");

@@ -114,7 +114,7 @@ int RunPipeline(int argc, char** argv) {
 
   if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {
     // Before the orientation fields' minutes, not after them.
-    Workspace::Read(workspace_path).RequireUndistortedCameras();
+    Workspace::Read(workspace_path, stereo_options.mask_path).RequireUndistortedCameras();
   }
 
   const int num_stages = static_cast<int>(stages.size());
@@ -128,6 +128,7 @@ int RunPipeline(int argc, char** argv) {
     announce("orientation fields");
     OrientationFieldsRunOptions run_options;
     run_options.image_names = image_names;
+    run_options.mask_path = stereo_options.mask_path;
     run_options.write_png = write_png;
     run_options.opencl_device = opencl_options.device;
     const OrientationFieldsResult result =

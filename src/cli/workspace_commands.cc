@@ -70,6 +70,7 @@ int RunWorkspaceInfo(int argc, char** argv) {
   THROW_IF(!field_options.Check(&error), "invalid --OrientationField options: " << error);
   Timer timer;
   const WorkspaceInfo info = ComputeWorkspaceInfo(workspace_path, mask_path, options);
+  stereo_options.mask_path = mask_path;  // the fields' provenance names the masks
   std::printf("%s", info.Report().c_str());
   PrintOutputs(workspace_path, stereo_options, field_options);
   std::printf("Total run time %.3f s (peak memory %.0f MiB)\n", timer.ElapsedSeconds(),

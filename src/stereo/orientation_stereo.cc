@@ -418,7 +418,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   THROW_IF(!options.Check(&error), "invalid --OrientationStereo options: " << error);
   StageTimings local_timings;
   if (timings == nullptr) timings = &local_timings;
-  const Workspace workspace = Workspace::Read(workspace_path);
+  const Workspace workspace = Workspace::Read(workspace_path, options.mask_path);
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
   workspace.RequireUndistortedCameras();
@@ -842,7 +842,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 std::vector<ViewOutputs> WorkspaceOutputs(const std::string& workspace_path,
                                           const OrientationStereoOptions& options,
                                           const OrientationFieldOptions& field_options) {
-  const Workspace workspace = Workspace::Read(workspace_path);
+  const Workspace workspace = Workspace::Read(workspace_path, options.mask_path);
   std::vector<ViewOutputs> outputs;
   for (const std::string& name : workspace.ImageNames()) {
     ViewOutputs view;

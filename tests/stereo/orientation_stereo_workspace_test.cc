@@ -219,6 +219,49 @@ TEST(OrientationStereoWorkspace, ComputesMissingFieldsWithTheGivenFilter) {
   std::filesystem::remove_all(root);
 }
 
+// OrientationStereo.mask_path: masks kept outside the workspace (as COLMAP's
+// StereoFusion.mask_path) restrict the depths, and the cached fields record them, so that the
+// same run without them computes the fields again. A missing folder is named.
+TEST(OrientationStereoWorkspace, MaskPathOutsideTheWorkspace) {
+  const std::string root = MakeTestDir("stereo_mask_path");
+  const std::string path = JoinPaths(root, "ws"), masks = JoinPaths(root, "my_masks");
+  WriteWorkspace(path);
+  CreateDirs(masks);
+  cv::Mat left_half(72, 96, CV_8U, cv::Scalar(0));
+  left_half(cv::Rect(0, 0, 48, 72)).setTo(255);
+  for (const std::string& name : kViewNames) {
+    ASSERT_TRUE(cv::imwrite(JoinPaths(masks, name + ".png"), left_half));
+  }
+  OrientationStereoOptions options = PlaneOptions();
+  options.mask_path = masks;
+  StageTimings timings;
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  const Workspace workspace = Workspace::Read(path, masks);
+  const FloatMap depth = ReadMat(workspace.DepthMapPath("v0.png"));
+  int kept = 0, outside = 0;
+  for (int row = 0; row < 72; ++row) {
+    for (int col = 0; col < 96; ++col) {
+      if (!(depth.At(row, col) > 0)) continue;
+      (col < 48 ? kept : outside) += 1;
+    }
+  }
+  EXPECT_GT(kept, 48 * 72 / 2);
+  EXPECT_EQ(outside, 0);
+  const OrientationFieldOptions fields;
+  for (const ViewOutputs& view : WorkspaceOutputs(path, options, fields)) {
+    EXPECT_EQ(view.fields, ViewOutputs::Fields::kUpToDate) << view.name << ": " << view.why_stale;
+  }
+  // Without the masks, the cached fields (computed with them) are stale.
+  EXPECT_EQ(WorkspaceOutputs(path, PlaneOptions(), fields)[0].fields,
+            ViewOutputs::Fields::kStale);
+  options.mask_path = JoinPaths(root, "nowhere");
+  const std::string error =
+      ErrorOf([&] { RunOrientationStereo(path, {"v0.png"}, options, &timings); });
+  EXPECT_NE(error.find("Missing mask folder"), std::string::npos) << error;
+  EXPECT_NE(error.find("nowhere"), std::string::npos) << error;
+  std::filesystem::remove_all(root);
+}
+
 // WorkspaceOutputs (workspace_info) says what a run left: the fields every view's estimate
 // cached, the reference's maps, and which fields another filter would compute again.
 TEST(OrientationStereoWorkspace, WorkspaceOutputsSaysWhatIsLeft) {
