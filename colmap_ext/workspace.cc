@@ -37,7 +37,7 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
     ws.image_names_.push_back(image.name);
   }
   if (!mask_path.empty()) {
-    THROW_IF(!ExistsDir(mask_path), "Missing mask folder (--mask_path): " << mask_path);
+    THROW_IF(!ExistsDir(mask_path), "Missing mask folder (the mask_path given): " << mask_path);
     ws.mask_path_ = mask_path;
   } else if (ExistsDir(JoinPaths(path, "masks"))) {
     ws.mask_path_ = JoinPaths(path, "masks");
