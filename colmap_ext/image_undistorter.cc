@@ -89,7 +89,8 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,
-                                      const std::string& workspace_path) {
+                                      const std::string& workspace_path,
+                                      int max_image_size) {
   RequireDir(mask_path, "mask folder of the photos");
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
@@ -128,7 +129,8 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   if (result.images_without_mask.size() == workspace.ImageNames().size()) return result;
   const std::string undistorted = JoinPaths(scratch.Path(), "undistorted");
   const int status = Undistort(colmap_executable, binarised, input_path, undistorted,
-                               " --image_list_path " + ShellQuote(list_path));
+                               " --image_list_path " + ShellQuote(list_path) +
+                                   " --max_image_size " + std::to_string(max_image_size));
   THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
                             << status << ") on the masks of " << mask_path << " with --input_path "
                             << input_path);
@@ -139,10 +141,10 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
     const Camera& camera = workspace.Model().cameras.at(workspace.ImageByName(name).camera_id);
     THROW_IF(mask.empty() || mask.cols != static_cast<int>(camera.width) ||
                  mask.rows != static_cast<int>(camera.height),
-             "colmap image_undistorter did not write the mask of " << name << " at its image's "
-                                                                   << camera.width << " x "
-                                                                   << camera.height << " ("
-                                                                   << path << ")");
+             "The undistorted mask of " << name << " (" << path << ") is not its image's "
+                 << camera.width << " x " << camera.height << ": was " << workspace_path
+                 << " undistorted from " << input_path
+                 << " with other options (--max_image_size)?");
     cv::Mat binary;
     cv::threshold(mask, binary, 127, 255, cv::THRESH_BINARY);
     WriteImage(JoinPaths(workspace_path, "masks", name + ".png"), binary);

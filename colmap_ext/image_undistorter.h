@@ -20,15 +20,18 @@ struct MaskUndistortionResult {
 
 // Masks drawn on the photos (`mask_path`/<photo name>.png, 0 = excluded, COLMAP's naming) do
 // not line up with the undistorted images, whose size and pixels the undistorter changed. This
-// runs `colmap image_undistorter` again on the masks, binarised and with the same options as
-// RunImageUndistorter, in a folder under the system's temporary directory, and writes each
-// result, thresholded at half (the undistorter interpolates), as
-// `workspace_path`/masks/<image name>.png. Call it after RunImageUndistorter made the workspace.
-// Throws hairmvs::Error naming the mask for one that is empty or of another aspect ratio than
-// its photo (ReadMask's rules), and the folders if the undistorter fails.
+// runs `colmap image_undistorter` again on the masks, binarised, in a folder under the system's
+// temporary directory, and writes each result, thresholded at half (the undistorter
+// interpolates), as `workspace_path`/masks/<image name>.png. Call it after RunImageUndistorter
+// made the workspace, or on a workspace the user made with `colmap image_undistorter` from the
+// same model, passing the --max_image_size it was given (-1: none; COLMAP's other undistorter
+// options must be their defaults). Throws hairmvs::Error naming the mask for one that is empty
+// or of another aspect ratio than its photo (ReadMask's rules), the folders if the undistorter
+// fails, and the image whose undistorted mask is not its size (another model or options).
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,
-                                      const std::string& workspace_path);
+                                      const std::string& workspace_path,
+                                      int max_image_size = -1);
 
 }  // namespace hairmvs

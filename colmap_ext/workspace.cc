@@ -302,8 +302,9 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     THROW_IF(std::abs(height_at_width - height) > 1 && std::abs(width_at_height - width) > 1,
              "Mask " << path << " is " << keep.cols << " x " << keep.rows
                      << ", another aspect ratio than its image's (read at " << width << " x "
-                     << height << "): draw masks on the images in the workspace's images/, "
-                        "as colmap image_undistorter wrote them");
+                     << height << "): a mask is drawn on its own image (the workspace's "
+                        "images/ as colmap image_undistorter wrote them, or the photo for "
+                        "undistort_masks), or is a scaled copy of one");
     cv::Mat resized;
     cv::resize(keep, resized, cv::Size(width, height), 0, 0, cv::INTER_NEAREST);
     keep = resized;

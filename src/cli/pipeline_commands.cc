@@ -108,8 +108,10 @@ int RunPipeline(int argc, char** argv) {
              "--photo_mask_path " << photo_mask_path
                  << " holds masks of the photos, undistorted only when the workspace is "
                     "created; "
-                 << workspace_path << " exists: put masks drawn on its images in "
-                 << workspace_path << "/masks");
+                 << workspace_path << " exists: run `hairmvs undistort_masks "
+                 << "--workspace_path " << workspace_path << " --input_path <its sparse model> "
+                 << "--photo_mask_path " << photo_mask_path << "`, or put masks drawn on its "
+                 << "images in " << workspace_path << "/masks");
   }
 
   if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {

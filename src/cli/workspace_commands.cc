@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "colmap_ext/image_undistorter.h"
 #include "colmap_ext/workspace_info.h"
 #include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
@@ -78,8 +79,41 @@ int RunWorkspaceInfo(int argc, char** argv) {
   return 0;
 }
 
+int RunUndistortMasks(int argc, char** argv) {
+  std::string workspace_path;
+  std::string input_path;
+  std::string photo_mask_path;
+  std::string colmap_executable = "colmap";
+  int max_image_size = -1;
+  OptionParser parser("undistort_masks",
+                      "Undistorts masks drawn on the photos into a dense workspace's masks/, "
+                      "exactly as colmap image_undistorter undistorted the photos (it runs "
+                      "again on the masks).");
+  parser.Add("workspace_path", &workspace_path,
+             "COLMAP dense workspace made by colmap image_undistorter", true);
+  parser.Add("input_path", &input_path, "the sparse model it was undistorted from", true);
+  parser.Add("photo_mask_path", &photo_mask_path,
+             "masks of the photos, <photo name>.png (0 = excluded)", true);
+  parser.Add("max_image_size", &max_image_size,
+             "the --max_image_size image_undistorter was given (-1: none)");
+  parser.Add("colmap_executable", &colmap_executable, "colmap binary");
+  if (!parser.Parse(argc, argv)) return 0;
+  Timer timer;
+  const MaskUndistortionResult result = UndistortMasks(colmap_executable, photo_mask_path,
+                                                       input_path, workspace_path,
+                                                       max_image_size);
+  std::printf("Undistorted %d mask(s) of %s into %s/masks (%zu image(s) without a mask) in "
+              "%.1f s\n",
+              result.num_masks, photo_mask_path.c_str(), workspace_path.c_str(),
+              result.images_without_mask.size(), timer.ElapsedSeconds());
+  return 0;
+}
+
 }  // namespace
 
+HAIRMVS_REGISTER_COMMAND("undistort_masks", RunUndistortMasks,
+                         "masks drawn on the photos, undistorted as the photos were into a "
+                         "dense workspace's masks/");
 HAIRMVS_REGISTER_COMMAND("workspace_info", RunWorkspaceInfo,
                          "views, cameras, masks, source views (and why), depth ranges of a "
                          "dense workspace, and what of each view is computed already");

@@ -209,7 +209,7 @@ TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
 // Masks drawn on distorted photos are undistorted as the photos are: the written mask matches
 // the undistorted photo's own content pixel for pixel (but its rim), where the photo's mask
 // merely resized to the new size does not. A photo without a mask gets none; a mask of another
-// aspect ratio is named.
+// aspect ratio is named. A workspace undistorted with --max_image_size needs it given too.
 TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_undistort_masks");
@@ -277,6 +277,24 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
     RecordProperty(std::string("agreement_") + name, Format(agree));
     RecordProperty(std::string("agreement_resized_") + name, Format(agree_resized));
   }
+
+  // A workspace the user undistorted with --max_image_size: the masks need the same option,
+  // and without it the size that comes out is named.
+  const std::string small_path = JoinPaths(dir, "dense_small");
+  EXPECT_COLMAP_OK("image_undistorter --image_path " + photos + " --input_path " + sparse +
+                       " --output_path " + small_path + " --max_image_size 200",
+                   dir);
+  const std::string size_error =
+      ErrorOf([&] { UndistortMasks(ColmapExecutable(), masks, sparse, small_path); });
+  EXPECT_NE(size_error.find("--max_image_size"), std::string::npos) << size_error;
+  EXPECT_EQ(UndistortMasks(ColmapExecutable(), masks, sparse, small_path, 200).num_masks, 2);
+  const Workspace small = Workspace::Read(small_path);
+  const cv::Mat small_mask = cv::imread(small.MaskPath("a.jpg"), cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(small_mask.cols, 200);
+  cv::Mat small_content;
+  cv::cvtColor(cv::imread(small.ImagePath("a.jpg")), small_content, cv::COLOR_BGR2GRAY);
+  cv::threshold(small_content, small_content, 127, 255, cv::THRESH_BINARY);
+  EXPECT_GT(cv::countNonZero(small_mask == small_content) / double(small_mask.total()), 0.99);
 
   cv::Mat narrow;
   cv::resize(photo_mask, narrow, cv::Size(width, height / 2));
