@@ -3,16 +3,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
@@ -99,6 +94,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   const std::string binarised = JoinPaths(scratch.Path(), "masks");
   const std::string list_path = JoinPaths(scratch.Path(), "image_list.txt");
   MaskUndistortionResult result;
+  std::vector<std::string> masked;  // the images that have a mask
   std::ofstream list(list_path);
   for (const std::string& name : workspace.ImageNames()) {
     const std::string path = workspace.MaskPath(name);
@@ -107,26 +103,18 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
       continue;
     }
     const Camera& camera = photos.cameras.at(photos.ImageByName(name).camera_id);
-    // At the photo's size, 255 where ReadMask keeps, so that the undistorter's interpolation
-    // halves only at the rim. Written as PNG under the photo's own name, whatever its extension:
-    // colmap reads an image by its content.
-    const FloatMap keep = ReadMask(path, static_cast<int>(camera.width),
-                                   static_cast<int>(camera.height));
-    cv::Mat bytes(keep.Height(), keep.Width(), CV_8U);
-    for (int r = 0; r < keep.Height(); ++r) {
-      for (int c = 0; c < keep.Width(); ++c) bytes.at<uint8_t>(r, c) = keep.At(r, c) > 0 ? 255 : 0;
-    }
-    std::vector<uint8_t> png;
-    THROW_IF(!cv::imencode(".png", bytes, png), "Cannot encode the mask " << path);
+    // At the photo's size, 1 where ReadMask keeps, so that the undistorter's interpolation
+    // halves only at the rim. Staged as PNG under the photo's own name, whatever its
+    // extension: colmap reads an image by its content.
     const std::string staged = JoinPaths(binarised, name);
-    CreateDirs(ParentPath(staged));
-    std::ofstream out(staged, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-    THROW_IF(!out, "Cannot write " << staged);
+    WriteImage(staged + ".png", ReadMask(path, static_cast<int>(camera.width),
+                                         static_cast<int>(camera.height)));
+    fs::rename(staged + ".png", staged);
     list << name << "\n";
+    masked.push_back(name);
   }
   list.close();
-  if (result.images_without_mask.size() == workspace.ImageNames().size()) return result;
+  if (masked.empty()) return result;
   const std::string undistorted = JoinPaths(scratch.Path(), "undistorted");
   const int status = Undistort(colmap_executable, binarised, input_path, undistorted,
                                " --image_list_path " + ShellQuote(list_path) +
@@ -134,20 +122,20 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
                             << status << ") on the masks of " << mask_path << " with --input_path "
                             << input_path);
-  for (const std::string& name : workspace.ImageNames()) {
-    if (workspace.MaskPath(name).empty()) continue;
+  for (const std::string& name : masked) {
     const std::string path = JoinPaths(undistorted, "images", name);
-    const cv::Mat mask = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    THROW_IF(!ExistsFile(path), "colmap image_undistorter wrote no " << path << " for the mask of "
+                                                                     << name);
+    FloatMap mask = ReadImageGray(path);
     const Camera& camera = workspace.Model().cameras.at(workspace.ImageByName(name).camera_id);
-    THROW_IF(mask.empty() || mask.cols != static_cast<int>(camera.width) ||
-                 mask.rows != static_cast<int>(camera.height),
+    THROW_IF(mask.Width() != static_cast<int>(camera.width) ||
+                 mask.Height() != static_cast<int>(camera.height),
              "The undistorted mask of " << name << " (" << path << ") is not its image's "
                  << camera.width << " x " << camera.height << ": was " << workspace_path
                  << " undistorted from " << input_path
                  << " with other options (--max_image_size)?");
-    cv::Mat binary;
-    cv::threshold(mask, binary, 127, 255, cv::THRESH_BINARY);
-    WriteImage(JoinPaths(workspace_path, "masks", name + ".png"), binary);
+    for (float& value : mask.Data()) value = value > 0.5f ? 1.0f : 0.0f;  // 128 of 255 and up
+    WriteImage(JoinPaths(workspace_path, "masks", name + ".png"), mask);
     ++result.num_masks;
   }
   return result;
