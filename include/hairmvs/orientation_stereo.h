@@ -532,6 +532,9 @@ struct OrientationStereoOptions {
   int WindowPx(int level) const;
   // Orientation pyramid levels to compute: the data term's and the coarse stage's grid.
   int PyramidLevels() const { return std::max(num_levels, coarse_level + 1); }
+  // The name of the maps a view ends with: "geometric" after the geometric pass, else
+  // single_pass_type.
+  std::string FinalMapType() const { return geom_consistency ? "geometric" : single_pass_type; }
   // Whether the data term matches orientation fields (orientation or combined cost).
   bool MatchesOrientation() const { return cost != StereoCost::kPhotometric; }
   // Whether the data term matches colours (photometric or combined cost).

@@ -93,7 +93,7 @@ int RunPipeline(int argc, char** argv) {
                                              << "); give --image_path and --input_path to "
                                                 "create it with colmap image_undistorter");
     ScopedStageTimer timer(&timings, "image_undistorter");
-    if (!photo_mask_path.empty()) {
+    if (!photo_mask_path.empty()) {  // before the photos' undistortion, not after it
       RequireDir(photo_mask_path, "mask folder (--photo_mask_path)");
     }
     RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
@@ -201,7 +201,8 @@ int RunPipeline(int argc, char** argv) {
     std::printf("  %s/stereo/depth_maps/*.png, normal_maps/*.png   depth and normal pictures\n", w);
   }
   if (HasStage(stages, "stereo")) {
-    std::printf("  %s/stereo/depth_maps/*.geometric.bin   for colmap stereo_fusion\n", w);
+    std::printf("  %s/stereo/depth_maps/*.%s.bin   for colmap stereo_fusion\n", w,
+                stereo_options.FinalMapType().c_str());
   }
   if (!ground_truth_path.empty()) {
     std::printf("  %s/stereo/evaluation/*.png   error pictures\n", w);

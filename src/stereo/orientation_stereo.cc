@@ -456,8 +456,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   // estimates first and those that start at the geometric pass.
   std::vector<std::string> to_run, to_estimate;
   std::set<std::string> resumed;
-  // The maps a view ends with.
-  const std::string final_type = options.geom_consistency ? "geometric" : options.single_pass_type;
+  const std::string final_type = options.FinalMapType();
   for (const std::string& name : names) {
     if (options.skip_existing && HasDepthAndNormals(workspace, name, final_type)) {
       std::printf("  %s: skipped: its .%s depth and normal maps exist (delete them to compute "
