@@ -222,9 +222,14 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
                  cv::FILLED);
     }
   }
-  cv::Mat photo_mask;
-  cv::cvtColor(photo, photo_mask, cv::COLOR_BGR2GRAY);
-  cv::threshold(photo_mask, photo_mask, 127, 255, cv::THRESH_BINARY);
+  // A picture's own mask: its bright pixels.
+  auto content_mask = [](const cv::Mat& bgr) {
+    cv::Mat mask;
+    cv::cvtColor(bgr, mask, cv::COLOR_BGR2GRAY);
+    cv::threshold(mask, mask, 127, 255, cv::THRESH_BINARY);
+    return mask;
+  };
+  const cv::Mat photo_mask = content_mask(photo);
   const std::string photos = JoinPaths(dir, "photos"), masks = JoinPaths(dir, "photo_masks");
   CreateDirs(photos);
   CreateDirs(masks);
@@ -264,9 +269,7 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
     ASSERT_EQ(mask.cols, static_cast<int>(camera.width));
     ASSERT_EQ(mask.rows, static_cast<int>(camera.height));
     ASSERT_EQ(mask.type(), CV_8U);
-    cv::Mat content;
-    cv::cvtColor(cv::imread(ws.ImagePath(name)), content, cv::COLOR_BGR2GRAY);
-    cv::threshold(content, content, 127, 255, cv::THRESH_BINARY);
+    const cv::Mat content = content_mask(cv::imread(ws.ImagePath(name)));
     cv::Mat resized;
     cv::resize(photo_mask, resized, mask.size(), 0, 0, cv::INTER_NEAREST);
     const double n = static_cast<double>(mask.total());
@@ -291,9 +294,7 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   const Workspace small = Workspace::Read(small_path);
   const cv::Mat small_mask = cv::imread(small.MaskPath("a.jpg"), cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(small_mask.cols, 200);
-  cv::Mat small_content;
-  cv::cvtColor(cv::imread(small.ImagePath("a.jpg")), small_content, cv::COLOR_BGR2GRAY);
-  cv::threshold(small_content, small_content, 127, 255, cv::THRESH_BINARY);
+  const cv::Mat small_content = content_mask(cv::imread(small.ImagePath("a.jpg")));
   EXPECT_GT(cv::countNonZero(small_mask == small_content) / double(small_mask.total()), 0.99);
 
   cv::Mat narrow;
