@@ -28,8 +28,9 @@ using namespace testing_util;
 
 const std::vector<std::string> kViewNames = {"v0.png", "v1.png", "v2.png", "v3.png"};
 
-// Writes the workspace; returns the true depth map of every view (v0, v1, v2, v3).
-std::vector<FloatMap> WriteWorkspace(const std::string& path) {
+// Writes the workspace; returns the true depth map of every view (v0, v1, v2, v3). The images
+// are named <folder>v0.png ...: COLMAP names an image by its path under the image folder.
+std::vector<FloatMap> WriteWorkspace(const std::string& path, const std::string& folder = "") {
   Surface plane;
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.3), 0, -std::cos(0.3));
@@ -48,14 +49,14 @@ std::vector<FloatMap> WriteWorkspace(const std::string& path) {
   camera.params = {100, 100, 48, 36};
   model.cameras[1] = camera;
   std::vector<FloatMap> true_depths;
-  CreateDirs(JoinPaths(path, "images"));
+  CreateDirs(JoinPaths(path, "images", folder));
   for (size_t i = 0; i < cameras.size(); ++i) {
     const RenderedView view = RenderView(cameras[i], plane, strands);
     true_depths.push_back(view.depth);
     Image image;
     image.image_id = static_cast<uint32_t>(i + 1);
     image.camera_id = 1;
-    image.name = "v" + std::to_string(i) + ".png";
+    image.name = folder + "v" + std::to_string(i) + ".png";
     image.cam_from_world_rotation = Eigen::Quaterniond(cameras[i].R);
     image.cam_from_world_translation = cameras[i].t;
     model.images[image.image_id] = image;
@@ -74,11 +75,11 @@ std::vector<FloatMap> WriteWorkspace(const std::string& path) {
   CreateDirs(JoinPaths(path, "stereo"));
   std::ofstream cfg(JoinPaths(path, "stereo", "patch-match.cfg"));
   for (int i = 0; i < 4; ++i) {
-    cfg << "v" << i << ".png\n";
+    cfg << folder << "v" << i << ".png\n";
     bool first = true;
     for (int j = 0; j < 4; ++j) {
       if (j == i) continue;
-      cfg << (first ? "" : ", ") << "v" << j << ".png";
+      cfg << (first ? "" : ", ") << folder << "v" << j << ".png";
       first = false;
     }
     cfg << "\n";
@@ -170,6 +171,37 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   EXPECT_TRUE(ExistsFile(workspace.OrientationMapPath("v1.png", 0)));
   // Its sources have no depth maps yet: the .geometric map is the estimate, unfiltered.
   EXPECT_EQ(depth.Data(), ReadMat(workspace.DepthMapPath("v0.png", "photometric")).Data());
+  std::filesystem::remove_all(path);
+}
+
+// Images in sub-folders (a rig's cameras in folders of their own: COLMAP names them
+// "rig/v0.png"): their masks, fields and maps sit in the same sub-folders of masks/ and
+// stereo/, where colmap stereo_fusion looks for them.
+TEST(OrientationStereoWorkspace, ImagesInSubFolders) {
+  const std::string path = MakeTestDir("stereo_sub_folders");
+  const FloatMap true_depth = WriteWorkspace(path, "rig/")[0];
+  CreateDirs(JoinPaths(path, "masks", "rig"));
+  cv::Mat left_half(72, 96, CV_8U, cv::Scalar(0));
+  left_half(cv::Rect(0, 0, 48, 72)).setTo(255);
+  for (const std::string& name : kViewNames) {
+    ASSERT_TRUE(cv::imwrite(JoinPaths(path, "masks", "rig", name + ".png"), left_half));
+  }
+  StageTimings timings;
+  RunOrientationStereo(path, {"rig/v0.png"}, PlaneOptions(), &timings);
+  const std::string maps = JoinPaths(path, "stereo", "depth_maps", "rig");
+  ASSERT_TRUE(ExistsFile(JoinPaths(maps, "v0.png.geometric.bin")));
+  EXPECT_TRUE(ExistsFile(JoinPaths(path, "stereo", "normal_maps", "rig", "v0.png.geometric.bin")));
+  EXPECT_TRUE(ExistsFile(JoinPaths(path, "stereo", "orientation_maps", "rig", "v1.png.l0.bin")));
+  EXPECT_FALSE(ExistsFile(JoinPaths(maps, "v1.png.geometric.bin")));
+  const FloatMap depth = ReadMat(JoinPaths(maps, "v0.png.geometric.bin"));
+  int outside = 0;
+  for (int row = 0; row < 72; ++row) {
+    for (int col = 48; col < 96; ++col) outside += depth.At(row, col) > 0;
+  }
+  EXPECT_EQ(outside, 0);  // the masks were found
+  size_t count = 0;
+  EXPECT_LT(MedianAbsError(depth, true_depth, &count), 0.02);
+  EXPECT_GT(count, 48u * 72u / 2);
   std::filesystem::remove_all(path);
 }
 
