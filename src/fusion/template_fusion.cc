@@ -220,6 +220,8 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
                  normal_path << ": a normal map needs 3 channels and the size of its depth map "
                              << depth_path);
       } else {
+        // colmap stereo_fusion needs normal maps; we can do without them.
+        progress.Stage("no normal map " + normal_path + ": normals from the depth map");
         view.normal = NormalMapFromDepthMap(view.depth, view.K);
       }
       view.rgb = ResizeNearest(workspace.ReadViewRgb(name), view.depth.Width(),

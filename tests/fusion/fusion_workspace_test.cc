@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <opencv2/core.hpp>
@@ -144,6 +146,46 @@ TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
   const TriangleMesh colmap_result = ReadMeshPly(colmap_mesh);
   EXPECT_GT(colmap_result.vertices.size(), 100u);
   EXPECT_GT(colmap_result.faces.size(), 100u);
+  std::filesystem::remove_all(dir);
+}
+
+// Depth maps without normal maps (another tool's, or normal maps deleted to save space):
+// the normals of the fused points come from the depth maps, and the log says so per view.
+TEST(FusionWorkspace, NormalsFromTheDepthMapsWhereNormalMapsAreMissing) {
+  const std::string dir = MakeTempDir("no_normals");
+  testing::SceneOptions scene;
+  scene.width = 64;
+  scene.height = 48;
+  scene.focal_px = 60;
+  scene.distance = 3.5;
+  const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
+  WriteWorkspace(testing::RenderViews(sdf, scene), dir);
+  std::filesystem::remove_all(JoinPaths(dir, "stereo", "normal_maps"));
+  TemplateFusionOptions options;
+  options.point_stride_px = 1;
+  options.num_threads = 1;
+  StageTimings timings;
+  ::testing::internal::CaptureStderr();
+  const TemplateFusionResult result = RunTemplateFusion(dir, options, &timings);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("no normal map " + JoinPaths(dir, "stereo", "normal_maps")),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("normals from the depth map"), std::string::npos) << log;
+  const std::vector<FusedPoint> points = ReadFusedPly(result.fused_path);
+  ASSERT_GT(points.size(), 500u);
+  // Each fused normal against the torus' own (the SDF's gradient at the point).
+  std::vector<double> angles_deg;
+  for (const FusedPoint& p : points) {
+    const Eigen::Vector3d truth = testing::SdfGradient(sdf, p.xyz.cast<double>()).normalized();
+    const double cosine = std::clamp(truth.dot(p.normal.cast<double>().normalized()), -1.0, 1.0);
+    angles_deg.push_back(std::acos(cosine) * 180 / M_PI);
+  }
+  std::nth_element(angles_deg.begin(), angles_deg.begin() + angles_deg.size() / 2,
+                   angles_deg.end());
+  std::printf("median normal error %.2f deg over %zu points\n", angles_deg[angles_deg.size() / 2],
+              angles_deg.size());
+  EXPECT_LT(angles_deg[angles_deg.size() / 2], 3.0);  // measured 0.7 degrees
   std::filesystem::remove_all(dir);
 }
 
