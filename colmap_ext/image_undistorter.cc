@@ -3,11 +3,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
@@ -30,7 +35,7 @@ std::string ShellQuote(const std::string& text) {
 }
 
 // `colmap image_undistorter` with COLMAP's default options, the same for photos and masks.
-// Returns the exit status (-1 when it did not exit normally).
+// Returns system()'s status (0: it exited with 0).
 int Undistort(const std::string& colmap_executable, const std::string& image_path,
               const std::string& input_path, const std::string& output_path,
               const std::string& extra_arguments) {
@@ -40,21 +45,33 @@ int Undistort(const std::string& colmap_executable, const std::string& image_pat
                               ShellQuote(output_path) + " --output_type COLMAP" +
                               extra_arguments;
   std::fprintf(stderr, "[image_undistorter] %s\n", command.c_str());
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return std::system(command.c_str());
 }
 
-// A folder under the system's temporary directory, removed with everything in it at the end.
+// How a command that system() ran ended, for an error message. While it runs, system() has this
+// process ignore SIGINT, so a Ctrl-C stops colmap alone and is reported here.
+std::string DescribeStatus(int status) {
+  if (status == -1) return std::string("could not be started: ") + std::strerror(errno);
+  if (WIFEXITED(status)) return "exit status " + std::to_string(WEXITSTATUS(status));
+  if (WIFSIGNALED(status)) {
+    return "stopped by signal " + std::to_string(WTERMSIG(status)) + " (" +
+           strsignal(WTERMSIG(status)) + ")";
+  }
+  return "status " + std::to_string(status);
+}
+
+// A folder removed with everything in it at the end (unless released).
 class ScratchDir {
  public:
-  ScratchDir() {
-    static std::atomic<int> counter{0};
-    path_ = (fs::temp_directory_path() /
-             ("hairmvs_masks_" + std::to_string(getpid()) + "_" + std::to_string(counter++)))
-                .string();
+  explicit ScratchDir(std::string path) : path_(std::move(path)) {
     fs::remove_all(path_);
     CreateDirs(path_);
   }
+  // A folder of its own under the system's temporary directory.
+  ScratchDir()
+      : ScratchDir((fs::temp_directory_path() / ("hairmvs_masks_" + std::to_string(getpid()) +
+                                                  "_" + std::to_string(counter_++)))
+                       .string()) {}
   ~ScratchDir() {
     std::error_code ec;
     fs::remove_all(path_, ec);
@@ -64,21 +81,58 @@ class ScratchDir {
   const std::string& Path() const { return path_; }
 
  private:
+  static inline std::atomic<int> counter_{0};
   std::string path_;
 };
+
+// Moves what `from` holds into `to` (created if need be), sparse/ last: a workspace is whole
+// once its sparse/ exists (the pipeline creates one where sparse/ is missing). Nothing is moved
+// when an entry would replace one `to` has already.
+void PublishWorkspace(const std::string& from, const std::string& to) {
+  CreateDirs(to);
+  std::vector<fs::path> entries;
+  for (const fs::directory_entry& entry : fs::directory_iterator(from)) {
+    THROW_IF(fs::exists(fs::path(to) / entry.path().filename()),
+             "Cannot create the workspace " << to << ": it holds "
+                                            << (fs::path(to) / entry.path().filename()).string()
+                                            << " already (the undistorted workspace is left in "
+                                            << from << ")");
+    entries.push_back(entry.path());
+  }
+  std::stable_partition(entries.begin(), entries.end(),
+                        [](const fs::path& p) { return p.filename() != "sparse"; });
+  for (const fs::path& entry : entries) {
+    std::error_code ec;
+    fs::rename(entry, fs::path(to) / entry.filename(), ec);
+    THROW_IF(ec, "Cannot move " << entry.string() << " into the workspace " << to << ": "
+                                << ec.message());
+  }
+}
 
 }  // namespace
 
 void RunImageUndistorter(const std::string& colmap_executable, const std::string& image_path,
-                         const std::string& input_path, const std::string& workspace_path) {
+                         const std::string& input_path, const std::string& workspace_path,
+                         const std::function<void(const std::string&)>& before_publishing) {
   RequireDir(image_path, "image folder (--image_path)");
   RequireDir(input_path, "sparse model folder (--input_path)");
-  CreateDirs(workspace_path);
-  const int status = Undistort(colmap_executable, image_path, input_path, workspace_path, "");
-  THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
-                            << status << ") for --image_path " << image_path
-                            << " --input_path " << input_path
-                            << "; is COLMAP installed (apt-get install colmap)?");
+  THROW_IF(ExistsDir(JoinPaths(workspace_path, "sparse")),
+           "Not creating the workspace " << workspace_path << ": it has a sparse/ model already");
+  fs::path target = fs::absolute(workspace_path).lexically_normal();
+  if (!target.has_filename()) target = target.parent_path();  // "dense/"
+  CreateDirs(target.parent_path().string());
+  // Beside the workspace (the same file system, so that its entries are renamed, not copied),
+  // hidden, and removed if anything fails or colmap is stopped.
+  const ScratchDir staging((target.parent_path() / ("." + target.filename().string() +
+                                                    ".undistorting" + std::to_string(getpid())))
+                               .string());
+  const int status = Undistort(colmap_executable, image_path, input_path, staging.Path(), "");
+  THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
+                            << " for --image_path " << image_path << " --input_path "
+                            << input_path << "; is COLMAP installed (apt-get install colmap)? "
+                            << "Nothing was written to " << workspace_path);
+  if (before_publishing) before_publishing(staging.Path());
+  PublishWorkspace(staging.Path(), workspace_path);
 }
 
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
@@ -119,9 +173,9 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   const int status = Undistort(colmap_executable, binarised, input_path, undistorted,
                                " --image_list_path " + ShellQuote(list_path) +
                                    " --max_image_size " + std::to_string(max_image_size));
-  THROW_IF(status != 0, "colmap image_undistorter failed (exit status "
-                            << status << ") on the masks of " << mask_path << " with --input_path "
-                            << input_path);
+  THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
+                                                    << " on the masks of " << mask_path
+                                                    << " with --input_path " << input_path);
   for (const std::string& name : masked) {
     const std::string path = JoinPaths(undistorted, "images", name);
     THROW_IF(!ExistsFile(path), "colmap image_undistorter wrote no " << path << " for the mask of "

@@ -2,6 +2,7 @@
 // `colmap image_undistorter`, run for hairmvs: a dense workspace made from a user's photos,
 // and the masks of those photos undistorted exactly as the photos were.
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -9,9 +10,17 @@ namespace hairmvs {
 
 // Runs `colmap image_undistorter --output_type COLMAP` (COLMAP's defaults otherwise), so that
 // `workspace_path` becomes the dense workspace of the photos in `image_path` and the model in
-// `input_path`. Throws hairmvs::Error naming the folders and the exit status.
-void RunImageUndistorter(const std::string& colmap_executable, const std::string& image_path,
-                         const std::string& input_path, const std::string& workspace_path);
+// `input_path`. The undistorter writes into a hidden folder beside `workspace_path`;
+// `before_publishing` (if given) runs on that folder once it is whole (the pipeline undistorts
+// the photos' masks there), and then its entries are moved into `workspace_path`, sparse/
+// last. So a creation that fails, or that Ctrl-C stops, leaves no half workspace for the next
+// run to take for a whole one (COLMAP creates sparse/ first and fills it last). Throws
+// hairmvs::Error naming the folders and how colmap ended, or the entry of an existing
+// `workspace_path` that the workspace would replace; refuses a `workspace_path` with a sparse/.
+void RunImageUndistorter(
+    const std::string& colmap_executable, const std::string& image_path,
+    const std::string& input_path, const std::string& workspace_path,
+    const std::function<void(const std::string& staged_workspace)>& before_publishing = {});
 
 struct MaskUndistortionResult {
   int num_masks = 0;                             // written to workspace_path/masks

@@ -96,12 +96,18 @@ int RunPipeline(int argc, char** argv) {
     if (!photo_mask_path.empty()) {  // before the photos' undistortion, not after it
       RequireDir(photo_mask_path, "mask folder (--photo_mask_path)");
     }
-    RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path);
+    // The masks too are undistorted before the workspace is published: a workspace without
+    // the masks asked for is not whole.
+    MaskUndistortionResult masks;
+    RunImageUndistorter(colmap_executable, image_path, input_path, workspace_path,
+                        [&](const std::string& staged_workspace) {
+                          if (photo_mask_path.empty()) return;
+                          masks = UndistortMasks(colmap_executable, photo_mask_path, input_path,
+                                                 staged_workspace);
+                        });
     if (!photo_mask_path.empty()) {
-      const MaskUndistortionResult masks =
-          UndistortMasks(colmap_executable, photo_mask_path, input_path, workspace_path);
-      std::fprintf(stderr, "[pipeline] undistorted %d mask(s) of %s into %s/masks\n",
-                   masks.num_masks, photo_mask_path.c_str(), workspace_path.c_str());
+      std::fprintf(stderr, "[pipeline] undistorted %d mask(s) of %s into %s\n", masks.num_masks,
+                   photo_mask_path.c_str(), JoinPaths(workspace_path, "masks").c_str());
     }
   } else {
     THROW_IF(!photo_mask_path.empty(),

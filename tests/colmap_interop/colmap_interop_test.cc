@@ -7,7 +7,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <csignal>
 #include <cmath>
+#include <functional>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -304,6 +307,95 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
       ErrorOf([&] { UndistortMasks(ColmapExecutable(), masks, sparse, workspace_path); });
   EXPECT_NE(error.find("c.png.png"), std::string::npos) << error;
   EXPECT_NE(error.find("aspect ratio"), std::string::npos) << error;
+}
+
+// The entries of `dir` (hidden ones too).
+std::vector<std::string> FolderEntries(const std::string& dir) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    names.push_back(entry.path().filename().string());
+  }
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+// A stand-in for colmap that writes the start of a workspace into its --output_path (as
+// colmap image_undistorter creates sparse/ first), then ends as `how` says.
+std::string WriteFailingColmap(const std::string& dir, const std::string& how) {
+  const std::string path = JoinPaths(dir, "colmap_" + std::to_string(std::hash<std::string>()(how)));
+  std::ofstream script(path);
+  script << "#!/bin/sh\n"
+         << "while [ $# -gt 0 ]; do [ \"$1\" = --output_path ] && out=$2; shift; done\n"
+         << "mkdir -p \"$out/sparse\" \"$out/images\" && touch \"$out/images/a.png\"\n"
+         << how << "\n";
+  script.close();
+  std::filesystem::permissions(path, std::filesystem::perms::owner_all);
+  return path;
+}
+
+// A workspace made from photos appears only once whole: colmap failing, stopped by Ctrl-C (its
+// shell killed by SIGINT), or the masks failing after it leave neither the workspace nor the
+// hidden folder it was made in; a whole one is published with everything the undistorter and
+// the step before publishing wrote.
+TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
+  REQUIRE_COLMAP();
+  const std::string dir = MakeTestDir("interop_publish");
+  const std::string photos = JoinPaths(dir, "photos"), sparse = JoinPaths(dir, "sparse");
+  CreateDirs(photos);
+  CreateDirs(sparse);
+  Reconstruction model = MakePlaneModel();
+  WriteReconstruction(model, sparse, ModelFormat::kText);
+  for (const auto& [id, image] : model.images) {
+    const Camera& camera = model.cameras.at(image.camera_id);
+    ASSERT_TRUE(cv::imwrite(JoinPaths(photos, image.name),
+                            cv::Mat(static_cast<int>(camera.height),
+                                    static_cast<int>(camera.width), CV_8UC3,
+                                    cv::Scalar(40, 80, 120))));
+  }
+  const std::string out = JoinPaths(dir, "out");
+  CreateDirs(out);
+  const std::string workspace = JoinPaths(out, "dense");
+  const std::vector<std::string> nothing;
+
+  std::string error = ErrorOf([&] {
+    RunImageUndistorter(WriteFailingColmap(dir, "exit 3"), photos, sparse, workspace);
+  });
+  EXPECT_NE(error.find("exit status 3"), std::string::npos) << error;
+  EXPECT_NE(error.find("Nothing was written to " + workspace), std::string::npos) << error;
+  EXPECT_EQ(FolderEntries(out), nothing);
+
+  error = ErrorOf([&] {
+    RunImageUndistorter(WriteFailingColmap(dir, "kill -INT $PPID $$"), photos, sparse, workspace);
+  });
+  EXPECT_NE(error.find("stopped by signal " + std::to_string(SIGINT)), std::string::npos)
+      << error;
+  EXPECT_EQ(FolderEntries(out), nothing);
+
+  error = ErrorOf([&] {
+    RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace,
+                        [](const std::string&) { HAIRMVS_THROW("the masks failed"); });
+  });
+  EXPECT_NE(error.find("the masks failed"), std::string::npos) << error;
+  EXPECT_EQ(FolderEntries(out), nothing);
+
+  // Whole: the step before publishing sees the undistorted workspace, not yet published.
+  RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace,
+                      [&](const std::string& staged) {
+                        EXPECT_FALSE(ExistsDir(workspace));
+                        EXPECT_TRUE(ExistsFile(JoinPaths(staged, "sparse", "cameras.bin")));
+                        WriteFileAtomically(JoinPaths(staged, "masks", "a.png.png"),
+                                            [](std::ostream& o) { o << "staged"; });
+                      });
+  EXPECT_EQ(FolderEntries(out), std::vector<std::string>{"dense"});
+  const Workspace ws = Workspace::Read(workspace);
+  EXPECT_EQ(ws.ImageNames().size(), model.images.size());
+  for (const std::string& name : ws.ImageNames()) EXPECT_TRUE(ExistsFile(ws.ImagePath(name)));
+  EXPECT_EQ(ReadTextFile(JoinPaths(workspace, "masks", "a.png.png")), "staged");
+  EXPECT_TRUE(ExistsFile(JoinPaths(workspace, "stereo", "patch-match.cfg")));
+  // A workspace is never made over one that has a model.
+  error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace); });
+  EXPECT_NE(error.find("has a sparse/ model already"), std::string::npos) << error;
+  std::filesystem::remove_all(dir);
 }
 
 TEST(ColmapInterop, PoissonMesherAcceptsOurFusedPly) {
