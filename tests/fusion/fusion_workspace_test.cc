@@ -69,21 +69,31 @@ void WriteWorkspace(const std::vector<FusionView>& views, const std::string& dir
   WriteReconstruction(model, JoinPaths(dir, "sparse"), ModelFormat::kBinary);
 }
 
-TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
-  const std::string dir = MakeTempDir("torus");
+// The torus' views (64 x 48) and the fusion options of the tests that fuse them.
+testing::SceneOptions TorusViews() {
   testing::SceneOptions scene;
   scene.width = 64;
   scene.height = 48;
   scene.focal_px = 60;
   scene.distance = 3.5;
+  return scene;
+}
+TemplateFusionOptions EveryPixelOneThread() {
+  TemplateFusionOptions options;
+  options.point_stride_px = 1;
+  options.num_threads = 1;
+  return options;
+}
+
+TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
+  const std::string dir = MakeTempDir("torus");
+  testing::SceneOptions scene = TorusViews();
   scene.depth_noise = 0.003;
   const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
   const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
   WriteWorkspace(views, dir);
 
-  TemplateFusionOptions options;
-  options.point_stride_px = 1;
-  options.num_threads = 1;
+  TemplateFusionOptions options = EveryPixelOneThread();
   options.write_intermediate = true;
   StageTimings timings;
   const TemplateFusionResult result = RunTemplateFusion(dir, options, &timings);
@@ -153,17 +163,10 @@ TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
 // the normals of the fused points come from the depth maps, and the log says so per view.
 TEST(FusionWorkspace, NormalsFromTheDepthMapsWhereNormalMapsAreMissing) {
   const std::string dir = MakeTempDir("no_normals");
-  testing::SceneOptions scene;
-  scene.width = 64;
-  scene.height = 48;
-  scene.focal_px = 60;
-  scene.distance = 3.5;
   const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
-  WriteWorkspace(testing::RenderViews(sdf, scene), dir);
+  WriteWorkspace(testing::RenderViews(sdf, TorusViews()), dir);
   std::filesystem::remove_all(JoinPaths(dir, "stereo", "normal_maps"));
-  TemplateFusionOptions options;
-  options.point_stride_px = 1;
-  options.num_threads = 1;
+  const TemplateFusionOptions options = EveryPixelOneThread();
   StageTimings timings;
   ::testing::internal::CaptureStderr();
   const TemplateFusionResult result = RunTemplateFusion(dir, options, &timings);
