@@ -139,7 +139,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,
                                       const std::string& workspace_path,
-                                      int max_image_size) {
+                                      int max_image_size, bool overwrite) {
   RequireDir(mask_path, "mask folder of the photos");
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
@@ -169,6 +169,16 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   }
   list.close();
   if (masked.empty()) return result;
+  // Masks already there may be drawn by hand: replaced only when asked, and named before
+  // colmap runs.
+  if (!overwrite) {
+    for (const std::string& name : masked) {
+      const std::string target = JoinPaths(workspace_path, "masks", name + ".png");
+      THROW_IF(ExistsFile(target), "The workspace has a mask already: "
+                                       << target << " (undistort_masks replaces masks only with "
+                                       << "--overwrite 1)");
+    }
+  }
   const std::string undistorted = JoinPaths(scratch.Path(), "undistorted");
   const int status = Undistort(colmap_executable, binarised, input_path, undistorted,
                                " --image_list_path " + ShellQuote(list_path) +
@@ -176,6 +186,9 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
                                                     << " on the masks of " << mask_path
                                                     << " with --input_path " << input_path);
+  // Every mask is read, checked and thresholded before any is written, so that a mask that
+  // fails leaves the workspace's masks as they were.
+  const std::string thresholded = JoinPaths(scratch.Path(), "thresholded");
   for (const std::string& name : masked) {
     const std::string path = JoinPaths(undistorted, "images", name);
     THROW_IF(!ExistsFile(path), "colmap image_undistorter wrote no " << path << " for the mask of "
@@ -189,7 +202,11 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                  << " undistorted from " << input_path
                  << " with other options (--max_image_size)?");
     for (float& value : mask.Data()) value = value > 0.5f ? 1.0f : 0.0f;  // 128 of 255 and up
-    WriteImage(JoinPaths(workspace_path, "masks", name + ".png"), mask);
+    WriteImage(JoinPaths(thresholded, name + ".png"), mask);
+  }
+  for (const std::string& name : masked) {
+    CopyFileAtomically(JoinPaths(thresholded, name + ".png"),
+                       JoinPaths(workspace_path, "masks", name + ".png"));
     ++result.num_masks;
   }
   return result;

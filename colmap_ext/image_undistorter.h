@@ -37,10 +37,13 @@ struct MaskUndistortionResult {
 // options must be their defaults). Throws hairmvs::Error naming the mask for one that is empty
 // or of another aspect ratio than its photo (ReadMask's rules), the folders if the undistorter
 // fails, and the image whose undistorted mask is not its size (another model or options).
+// Every mask is checked before any is written, so a failure leaves the workspace's masks/ as
+// it was; a mask already in masks/ (drawn by hand, perhaps) is an error named before colmap
+// runs, unless `overwrite`.
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,
                                       const std::string& workspace_path,
-                                      int max_image_size = -1);
+                                      int max_image_size = -1, bool overwrite = false);
 
 }  // namespace hairmvs

@@ -85,6 +85,7 @@ int RunUndistortMasks(int argc, char** argv) {
   std::string photo_mask_path;
   std::string colmap_executable = "colmap";
   int max_image_size = -1;
+  bool overwrite = false;
   OptionParser parser("undistort_masks",
                       "Undistorts masks drawn on the photos into a dense workspace's masks/, "
                       "exactly as colmap image_undistorter undistorted the photos (it runs "
@@ -96,12 +97,12 @@ int RunUndistortMasks(int argc, char** argv) {
              "masks of the photos, <photo name>.png (0 = excluded)", true);
   parser.Add("max_image_size", &max_image_size,
              "the --max_image_size image_undistorter was given (-1: none)");
+  parser.Add("overwrite", &overwrite, "replace masks the workspace has already");
   parser.Add("colmap_executable", &colmap_executable, "colmap binary");
   if (!parser.Parse(argc, argv)) return 0;
   Timer timer;
-  const MaskUndistortionResult result = UndistortMasks(colmap_executable, photo_mask_path,
-                                                       input_path, workspace_path,
-                                                       max_image_size);
+  const MaskUndistortionResult result = UndistortMasks(
+      colmap_executable, photo_mask_path, input_path, workspace_path, max_image_size, overwrite);
   std::printf("Undistorted %d mask(s) of %s into %s/masks (%zu image(s) without a mask) in "
               "%.1f s\n",
               result.num_masks, photo_mask_path.c_str(), workspace_path.c_str(),

@@ -202,6 +202,11 @@ void WritePathAtomically(const std::string& path,
   RenameOver(tmp, path);
 }
 
+void CopyFileAtomically(const std::string& from, const std::string& to) {
+  const std::string bytes = ReadTextFile(from);
+  WriteFileAtomically(to, [&bytes](std::ostream& out) { out.write(bytes.data(), bytes.size()); });
+}
+
 void RemoveTemporaryFilesOnInterrupt() {
   for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction previous {};

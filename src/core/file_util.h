@@ -41,6 +41,8 @@ void WriteFileAtomically(const std::string& path,
 // with the same extension as `path`.
 void WritePathAtomically(const std::string& path,
                          const std::function<void(const std::string& tmp_path)>& write);
+// `from`'s bytes written to `to` with WriteFileAtomically.
+void CopyFileAtomically(const std::string& from, const std::string& to);
 
 // Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
 // temporary files of the writes above still in flight, then let the signal end the process as

@@ -35,11 +35,6 @@ bool IsSameOrInside(const fs::path& inner, const fs::path& outer) {
   return true;
 }
 
-void CopyFileAtomically(const std::string& from, const std::string& to) {
-  const std::string bytes = ReadTextFile(from);
-  WriteFileAtomically(to, [&bytes](std::ostream& out) { out.write(bytes.data(), bytes.size()); });
-}
-
 // images/ or masks/ of the output: a symlink to the workspace's folder, or a copy.
 void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy) {
   if (!ExistsDir(from)) return;

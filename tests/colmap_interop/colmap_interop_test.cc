@@ -212,7 +212,8 @@ TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
 // Masks drawn on distorted photos are undistorted as the photos are: the written mask matches
 // the undistorted photo's own content pixel for pixel (but its rim), where the photo's mask
 // merely resized to the new size does not. A photo without a mask gets none; a mask of another
-// aspect ratio is named. A workspace undistorted with --max_image_size needs it given too.
+// aspect ratio is named. A workspace undistorted with --max_image_size needs it given too; a
+// failure writes no mask, and masks the workspace has are replaced only when asked.
 TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_undistort_masks");
@@ -293,7 +294,21 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   const std::string size_error =
       ErrorOf([&] { UndistortMasks(ColmapExecutable(), masks, sparse, small_path); });
   EXPECT_NE(size_error.find("--max_image_size"), std::string::npos) << size_error;
+  EXPECT_FALSE(ExistsDir(JoinPaths(small_path, "masks"))) << "a failure writes no mask";
   EXPECT_EQ(UndistortMasks(ColmapExecutable(), masks, sparse, small_path, 200).num_masks, 2);
+  // Masks the workspace has are not replaced unless asked, and are named before colmap runs.
+  const std::string small_mask_path = JoinPaths(small_path, "masks", "a.jpg.png");
+  const std::string before = ReadTextFile(small_mask_path);
+  const std::string exists_error = ErrorOf([&] {
+    UndistortMasks("/nonexistent/colmap", masks, sparse, small_path, 200);
+  });
+  EXPECT_NE(exists_error.find("has a mask already: " + JoinPaths(small_path, "masks")),
+            std::string::npos)
+      << exists_error;
+  EXPECT_NE(exists_error.find("--overwrite 1"), std::string::npos) << exists_error;
+  EXPECT_EQ(ReadTextFile(small_mask_path), before);
+  EXPECT_EQ(UndistortMasks(ColmapExecutable(), masks, sparse, small_path, 200, true).num_masks, 2);
+  EXPECT_EQ(ReadTextFile(small_mask_path), before);  // the same masks again
   const Workspace small = Workspace::Read(small_path);
   const cv::Mat small_mask = cv::imread(small.MaskPath("a.jpg"), cv::IMREAD_GRAYSCALE);
   ASSERT_EQ(small_mask.cols, 200);
