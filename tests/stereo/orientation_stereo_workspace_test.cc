@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -106,6 +107,28 @@ std::vector<FloatMap> ReadGeometricMaps(const Workspace& workspace) {
   return maps;
 }
 
+// Masks keeping the left half of every view, as <folder>/<view name>.png.
+void WriteLeftHalfMasks(const std::string& folder) {
+  CreateDirs(folder);
+  cv::Mat left_half(72, 96, CV_8U, cv::Scalar(0));
+  left_half(cv::Rect(0, 0, 48, 72)).setTo(255);
+  for (const std::string& name : kViewNames) {
+    ASSERT_TRUE(cv::imwrite(JoinPaths(folder, name + ".png"), left_half));
+  }
+}
+
+// The depths of `depth` in the left half (the masks of WriteLeftHalfMasks keep) and outside it.
+std::pair<int, int> DepthsInAndOutsideTheLeftHalf(const FloatMap& depth) {
+  int kept = 0, outside = 0;
+  for (int row = 0; row < 72; ++row) {
+    for (int col = 0; col < 96; ++col) {
+      if (!(depth.At(row, col) > 0)) continue;
+      (col < 48 ? kept : outside) += 1;
+    }
+  }
+  return {kept, outside};
+}
+
 TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane) {
   const std::string path = MakeTestDir("stereo_workspace");
   const FloatMap true_depth = WriteWorkspace(path)[0];
@@ -180,12 +203,7 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
 TEST(OrientationStereoWorkspace, ImagesInSubFolders) {
   const std::string path = MakeTestDir("stereo_sub_folders");
   const FloatMap true_depth = WriteWorkspace(path, "rig/")[0];
-  CreateDirs(JoinPaths(path, "masks", "rig"));
-  cv::Mat left_half(72, 96, CV_8U, cv::Scalar(0));
-  left_half(cv::Rect(0, 0, 48, 72)).setTo(255);
-  for (const std::string& name : kViewNames) {
-    ASSERT_TRUE(cv::imwrite(JoinPaths(path, "masks", "rig", name + ".png"), left_half));
-  }
+  WriteLeftHalfMasks(JoinPaths(path, "masks", "rig"));
   StageTimings timings;
   RunOrientationStereo(path, {"rig/v0.png"}, PlaneOptions(), &timings);
   const std::string maps = JoinPaths(path, "stereo", "depth_maps", "rig");
@@ -194,11 +212,7 @@ TEST(OrientationStereoWorkspace, ImagesInSubFolders) {
   EXPECT_TRUE(ExistsFile(JoinPaths(path, "stereo", "orientation_maps", "rig", "v1.png.l0.bin")));
   EXPECT_FALSE(ExistsFile(JoinPaths(maps, "v1.png.geometric.bin")));
   const FloatMap depth = ReadMat(JoinPaths(maps, "v0.png.geometric.bin"));
-  int outside = 0;
-  for (int row = 0; row < 72; ++row) {
-    for (int col = 48; col < 96; ++col) outside += depth.At(row, col) > 0;
-  }
-  EXPECT_EQ(outside, 0);  // the masks were found
+  EXPECT_EQ(DepthsInAndOutsideTheLeftHalf(depth).second, 0);  // the masks were found
   size_t count = 0;
   EXPECT_LT(MedianAbsError(depth, true_depth, &count), 0.02);
   EXPECT_GT(count, 48u * 72u / 2);
@@ -258,25 +272,14 @@ TEST(OrientationStereoWorkspace, MaskPathOutsideTheWorkspace) {
   const std::string root = MakeTestDir("stereo_mask_path");
   const std::string path = JoinPaths(root, "ws"), masks = JoinPaths(root, "my_masks");
   WriteWorkspace(path);
-  CreateDirs(masks);
-  cv::Mat left_half(72, 96, CV_8U, cv::Scalar(0));
-  left_half(cv::Rect(0, 0, 48, 72)).setTo(255);
-  for (const std::string& name : kViewNames) {
-    ASSERT_TRUE(cv::imwrite(JoinPaths(masks, name + ".png"), left_half));
-  }
+  WriteLeftHalfMasks(masks);
   OrientationStereoOptions options = PlaneOptions();
   options.mask_path = masks;
   StageTimings timings;
   RunOrientationStereo(path, {"v0.png"}, options, &timings);
   const Workspace workspace = Workspace::Read(path, masks);
   const FloatMap depth = ReadMat(workspace.DepthMapPath("v0.png"));
-  int kept = 0, outside = 0;
-  for (int row = 0; row < 72; ++row) {
-    for (int col = 0; col < 96; ++col) {
-      if (!(depth.At(row, col) > 0)) continue;
-      (col < 48 ? kept : outside) += 1;
-    }
-  }
+  const auto [kept, outside] = DepthsInAndOutsideTheLeftHalf(depth);
   EXPECT_GT(kept, 48 * 72 / 2);
   EXPECT_EQ(outside, 0);
   const OrientationFieldOptions fields;
