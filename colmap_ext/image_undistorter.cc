@@ -1,5 +1,6 @@
 #include "colmap_ext/image_undistorter.h"
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -60,18 +61,35 @@ std::string DescribeStatus(int status) {
   return "status " + std::to_string(status);
 }
 
-// A folder removed with everything in it at the end (unless released).
+// Scratch folders are named <prefix><pid>_<n>. One whose process is gone was left by a run
+// that a signal ended before it could remove it (the interrupt handler removes files, not
+// folders): removed by the next run that makes one in the same place.
+void RemoveScratchOfEndedRuns(const fs::path& parent, const std::string& prefix) {
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(parent, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0 || !entry.is_directory(ec)) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t digits = rest.find_first_not_of("0123456789");
+    if (digits == 0 || (digits != std::string::npos && rest[digits] != '_')) continue;
+    const long pid = std::stol(rest.substr(0, digits));
+    if (pid == getpid() || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
+              << ") that was stopped";
+    fs::remove_all(entry.path(), ec);
+  }
+}
+
+// A folder <parent>/<prefix><pid>_<n>, removed with everything in it at the end.
 class ScratchDir {
  public:
-  explicit ScratchDir(std::string path) : path_(std::move(path)) {
+  ScratchDir(const fs::path& parent, const std::string& prefix) {
+    RemoveScratchOfEndedRuns(parent, prefix);
+    path_ = (parent / (prefix + std::to_string(getpid()) + "_" + std::to_string(counter_++)))
+                .string();
     fs::remove_all(path_);
     CreateDirs(path_);
   }
-  // A folder of its own under the system's temporary directory.
-  ScratchDir()
-      : ScratchDir((fs::temp_directory_path() / ("hairmvs_masks_" + std::to_string(getpid()) +
-                                                  "_" + std::to_string(counter_++)))
-                       .string()) {}
   ~ScratchDir() {
     std::error_code ec;
     fs::remove_all(path_, ec);
@@ -123,9 +141,8 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   CreateDirs(target.parent_path().string());
   // Beside the workspace (the same file system, so that its entries are renamed, not copied),
   // hidden, and removed if anything fails or colmap is stopped.
-  const ScratchDir staging((target.parent_path() / ("." + target.filename().string() +
-                                                    ".undistorting" + std::to_string(getpid())))
-                               .string());
+  const ScratchDir staging(target.parent_path(),
+                           "." + target.filename().string() + ".undistorting");
   const int status = Undistort(colmap_executable, image_path, input_path, staging.Path(), "");
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
                             << " for --image_path " << image_path << " --input_path "
@@ -144,7 +161,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
   const Workspace workspace = Workspace::Read(workspace_path, mask_path);
-  const ScratchDir scratch;
+  const ScratchDir scratch(fs::temp_directory_path(), "hairmvs_masks_");
   const std::string binarised = JoinPaths(scratch.Path(), "masks");
   const std::string list_path = JoinPaths(scratch.Path(), "image_list.txt");
   MaskUndistortionResult result;

@@ -2,6 +2,8 @@
 // COLMAP reads (colmap-formats.md sections 4, 5 and 9).
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -351,7 +353,7 @@ std::string WriteFailingColmap(const std::string& dir, const std::string& how) {
 // A workspace made from photos appears only once whole: colmap failing, stopped by Ctrl-C (its
 // shell killed by SIGINT), or the masks failing after it leave neither the workspace nor the
 // hidden folder it was made in; a whole one is published with everything the undistorter and
-// the step before publishing wrote.
+// the step before publishing wrote, and removes what a run a signal ended left.
 TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_publish");
@@ -393,6 +395,16 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   EXPECT_NE(error.find("the masks failed"), std::string::npos) << error;
   EXPECT_EQ(FolderEntries(out), nothing);
 
+  // A hidden folder that a run stopped by a signal left (its process is gone) is removed by
+  // the next run; one of a process still running is not.
+  const pid_t ended = fork();
+  if (ended == 0) _exit(0);
+  ASSERT_EQ(waitpid(ended, nullptr, 0), ended);
+  const std::string left = ".dense.undistorting" + std::to_string(ended) + "_0";
+  const std::string running = ".dense.undistorting1_0";  // init's
+  for (const std::string& name : {left, running}) {
+    CreateDirs(JoinPaths(out, name, "images"));
+  }
   // Whole: the step before publishing sees the undistorted workspace, not yet published.
   RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace,
                       [&](const std::string& staged) {
@@ -401,7 +413,7 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
                         WriteFileAtomically(JoinPaths(staged, "masks", "a.png.png"),
                                             [](std::ostream& o) { o << "staged"; });
                       });
-  EXPECT_EQ(FolderEntries(out), std::vector<std::string>{"dense"});
+  EXPECT_EQ(FolderEntries(out), (std::vector<std::string>{running, "dense"}));
   const Workspace ws = Workspace::Read(workspace);
   EXPECT_EQ(ws.ImageNames().size(), model.images.size());
   for (const std::string& name : ws.ImageNames()) EXPECT_TRUE(ExistsFile(ws.ImagePath(name)));
