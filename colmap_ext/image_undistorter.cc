@@ -113,8 +113,7 @@ void PublishWorkspace(const std::string& from, const std::string& to) {
     THROW_IF(fs::exists(fs::path(to) / entry.path().filename()),
              "Cannot create the workspace " << to << ": it holds "
                                             << (fs::path(to) / entry.path().filename()).string()
-                                            << " already (the undistorted workspace is left in "
-                                            << from << ")");
+                                            << " already; nothing was moved into it");
     entries.push_back(entry.path());
   }
   std::stable_partition(entries.begin(), entries.end(),

@@ -419,9 +419,19 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   for (const std::string& name : ws.ImageNames()) EXPECT_TRUE(ExistsFile(ws.ImagePath(name)));
   EXPECT_EQ(ReadTextFile(JoinPaths(workspace, "masks", "a.png.png")), "staged");
   EXPECT_TRUE(ExistsFile(JoinPaths(workspace, "stereo", "patch-match.cfg")));
-  // A workspace is never made over one that has a model.
+  // A workspace is never made over one that has a model, nor over a folder holding an entry
+  // it would replace: nothing is moved into that folder.
   error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace); });
   EXPECT_NE(error.find("has a sparse/ model already"), std::string::npos) << error;
+  const std::string other = JoinPaths(out, "other");
+  WriteFileAtomically(JoinPaths(other, "images", "mine.txt"), [](std::ostream& o) { o << "x"; });
+  error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, sparse, other); });
+  EXPECT_NE(error.find("holds " + JoinPaths(other, "images") + " already; nothing was moved"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(FolderEntries(other), std::vector<std::string>{"images"});
+  EXPECT_EQ(FolderEntries(JoinPaths(other, "images")), std::vector<std::string>{"mine.txt"});
+  EXPECT_EQ(FolderEntries(out), (std::vector<std::string>{running, "dense", "other"}));
   std::filesystem::remove_all(dir);
 }
 
