@@ -70,8 +70,8 @@ void RemoveScratchOfEndedRuns(const fs::path& parent, const std::string& prefix)
     const std::string name = entry.path().filename().string();
     if (name.rfind(prefix, 0) != 0 || !entry.is_directory(ec)) continue;
     const std::string rest = name.substr(prefix.size());
-    const size_t digits = rest.find_first_not_of("0123456789");
-    if (digits == 0 || (digits != std::string::npos && rest[digits] != '_')) continue;
+    const size_t digits = std::min(rest.find_first_not_of("0123456789"), rest.size());
+    if (digits == 0 || digits > 9 || (digits < rest.size() && rest[digits] != '_')) continue;
     const long pid = std::stol(rest.substr(0, digits));
     if (pid == getpid() || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
