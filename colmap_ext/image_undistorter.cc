@@ -110,10 +110,10 @@ void PublishWorkspace(const std::string& from, const std::string& to) {
   CreateDirs(to);
   std::vector<fs::path> entries;
   for (const fs::directory_entry& entry : fs::directory_iterator(from)) {
-    THROW_IF(fs::exists(fs::path(to) / entry.path().filename()),
-             "Cannot create the workspace " << to << ": it holds "
-                                            << (fs::path(to) / entry.path().filename()).string()
-                                            << " already; nothing was moved into it");
+    const fs::path target = fs::path(to) / entry.path().filename();
+    THROW_IF(fs::exists(target), "Cannot create the workspace "
+                                     << to << ": it holds " << target.string()
+                                     << " already; nothing was moved into it");
     entries.push_back(entry.path());
   }
   std::stable_partition(entries.begin(), entries.end(),
@@ -163,6 +163,10 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   const ScratchDir scratch(fs::temp_directory_path(), "hairmvs_masks_");
   const std::string binarised = JoinPaths(scratch.Path(), "masks");
   const std::string list_path = JoinPaths(scratch.Path(), "image_list.txt");
+  // Where an image's undistorted mask goes.
+  auto workspace_mask = [&](const std::string& name) {
+    return JoinPaths(workspace_path, "masks", name + ".png");
+  };
   MaskUndistortionResult result;
   std::vector<std::string> masked;  // the images that have a mask
   std::ofstream list(list_path);
@@ -189,10 +193,9 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   // colmap runs.
   if (!overwrite) {
     for (const std::string& name : masked) {
-      const std::string target = JoinPaths(workspace_path, "masks", name + ".png");
-      THROW_IF(ExistsFile(target), "The workspace has a mask already: "
-                                       << target << " (undistort_masks replaces masks only with "
-                                       << "--overwrite 1)");
+      THROW_IF(ExistsFile(workspace_mask(name)),
+               "The workspace has a mask already: " << workspace_mask(name)
+                   << " (undistort_masks replaces masks only with --overwrite 1)");
     }
   }
   const std::string undistorted = JoinPaths(scratch.Path(), "undistorted");
@@ -221,8 +224,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
     WriteImage(JoinPaths(thresholded, name + ".png"), mask);
   }
   for (const std::string& name : masked) {
-    CopyFileAtomically(JoinPaths(thresholded, name + ".png"),
-                       JoinPaths(workspace_path, "masks", name + ".png"));
+    CopyFileAtomically(JoinPaths(thresholded, name + ".png"), workspace_mask(name));
     ++result.num_masks;
   }
   return result;

@@ -12,7 +12,6 @@
 #include <algorithm>
 #include <csignal>
 #include <cmath>
-#include <functional>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -336,10 +335,11 @@ std::vector<std::string> FolderEntries(const std::string& dir) {
   return names;
 }
 
-// A stand-in for colmap that writes the start of a workspace into its --output_path (as
-// colmap image_undistorter creates sparse/ first), then ends as `how` says.
-std::string WriteFailingColmap(const std::string& dir, const std::string& how) {
-  const std::string path = JoinPaths(dir, "colmap_" + std::to_string(std::hash<std::string>()(how)));
+// A stand-in for colmap, `dir`/`name`, that writes the start of a workspace into its
+// --output_path (as colmap image_undistorter creates sparse/ first), then ends as `how` says.
+std::string WriteFailingColmap(const std::string& dir, const std::string& name,
+                               const std::string& how) {
+  const std::string path = JoinPaths(dir, name);
   std::ofstream script(path);
   script << "#!/bin/sh\n"
          << "while [ $# -gt 0 ]; do [ \"$1\" = --output_path ] && out=$2; shift; done\n"
@@ -375,14 +375,15 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   const std::vector<std::string> nothing;
 
   std::string error = ErrorOf([&] {
-    RunImageUndistorter(WriteFailingColmap(dir, "exit 3"), photos, sparse, workspace);
+    RunImageUndistorter(WriteFailingColmap(dir, "exits", "exit 3"), photos, sparse, workspace);
   });
   EXPECT_NE(error.find("exit status 3"), std::string::npos) << error;
   EXPECT_NE(error.find("Nothing was written to " + workspace), std::string::npos) << error;
   EXPECT_EQ(FolderEntries(out), nothing);
 
   error = ErrorOf([&] {
-    RunImageUndistorter(WriteFailingColmap(dir, "kill -INT $PPID $$"), photos, sparse, workspace);
+    RunImageUndistorter(WriteFailingColmap(dir, "interrupted", "kill -INT $PPID $$"), photos,
+                        sparse, workspace);
   });
   EXPECT_NE(error.find("stopped by signal " + std::to_string(SIGINT)), std::string::npos)
       << error;
