@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <iomanip>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 
@@ -191,8 +192,12 @@ SourceViewSelection SelectAuto(const Workspace& ws, const Image& reference,
   int max_shared = 1;
   for (const Candidate& c : candidates) max_shared = std::max(max_shared, c.shared_points);
   while (static_cast<int>(chosen.size()) < num_sources && chosen.size() < candidates.size()) {
-    const bool allow_wide =
-        chosen.size() + num_wide >= candidates.size();  // only wide ones remain
+    // Wide ones only when no narrow one is left unchosen (the T group may hold wide ones).
+    bool allow_wide = true;
+    for (size_t i = 0; i < candidates.size() && allow_wide; ++i) {
+      allow_wide = candidates[i].angle75_rad > max_angle ||
+                   std::find(chosen.begin(), chosen.end(), i) != chosen.end();
+    }
     double best_score = -1;
     size_t best = 0;
     for (size_t i = 0; i < candidates.size(); ++i) {
@@ -260,6 +265,32 @@ void FillExplicitStats(const Workspace& ws, const Image& reference,
     selection->epipolar_direction_deg.push_back(RadToDeg(
         EpipolarDirectionRad(model, reference.image_id, other.image_id, centre_px)));
   }
+}
+
+// Keeps the `max_sources` sources sharing the most sparse points with the reference (ties: the
+// listed order), with their statistics, and says so in the reason.
+void KeepSourcesSharingMostPoints(int max_sources, SourceViewSelection* selection) {
+  const size_t num_listed = selection->sources.size();
+  std::vector<size_t> order(num_listed);
+  std::iota(order.begin(), order.end(), size_t{0});
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return selection->shared_points[a] > selection->shared_points[b];
+  });
+  order.resize(max_sources);
+  SourceViewSelection kept;
+  kept.reference = selection->reference;
+  kept.gantry_t_group = selection->gantry_t_group;
+  for (size_t i : order) {
+    kept.sources.push_back(selection->sources[i]);
+    kept.shared_points.push_back(selection->shared_points[i]);
+    kept.triangulation_angle_deg.push_back(selection->triangulation_angle_deg[i]);
+    kept.epipolar_direction_deg.push_back(selection->epipolar_direction_deg[i]);
+  }
+  std::ostringstream reason;
+  reason << selection->reason << "; the " << max_sources << " of " << num_listed
+         << " sharing the most sparse points kept (max_num_source_views)";
+  kept.reason = reason.str();
+  *selection = std::move(kept);
 }
 
 }  // namespace
@@ -331,6 +362,7 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
   const auto pair_stats = ComputePairStats(model);
   static const std::map<uint32_t, PairStats> kNoPairs;
   std::vector<SourceViewSelection> selections;
+  int num_capped = 0;  // references whose list was longer than max_num_source_views
   for (const PatchMatchProblem& problem : problems) {
     const Image& reference = model.ImageByName(problem.reference);
     const auto it = pair_stats.find(reference.image_id);
@@ -366,6 +398,12 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
         break;
       }
     }
+    // One cap for every kind: the estimate loads every source's fields and the geometric pass
+    // reads every source's map (COLMAP takes whole lists, and samples among them per pixel).
+    if (static_cast<int>(selection.sources.size()) > options.max_num_source_views) {
+      KeepSourcesSharingMostPoints(options.max_num_source_views, &selection);
+      ++num_capped;
+    }
     // COLMAP drops references without sources (with a warning).
     if (selection.sources.empty()) {
       LOG(WARNING) << "Ignoring reference image " << problem.reference
@@ -373,6 +411,13 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
       continue;
     }
     selections.push_back(std::move(selection));
+  }
+  if (num_capped > 0) {
+    LOG(WARNING) << cfg_path << ": " << num_capped << " reference(s) list more than "
+                 << options.max_num_source_views << " sources (explicitly or with __all__); "
+                 << "each keeps the " << options.max_num_source_views << " sharing the most "
+                 << "sparse points with it (--SourceViews.max_num_source_views keeps more; "
+                 << "hairmvs workspace_info lists them)";
   }
   return selections;
 }
@@ -491,9 +536,15 @@ std::vector<PatchMatchProblem> ReadPatchMatchConfig(const std::string& path,
       continue;
     }
     problem.line_number = static_cast<int>(i + 1);
-    std::vector<std::string> tokens = SplitString(line, ",;");
-    for (std::string& token : tokens) token = StripWhitespace(token);
-    if (tokens[0] == "__all__") {
+    // As COLMAP's CSVToVector: tokens trimmed, empty ones skipped (`a.png, b.png,` is two
+    // sources; a line of separators alone lists none, and the reference is dropped).
+    std::vector<std::string> tokens;
+    for (const std::string& token : SplitString(line, ",;")) {
+      if (!StripWhitespace(token).empty()) tokens.push_back(StripWhitespace(token));
+    }
+    if (tokens.empty()) {
+      problem.kind = PatchMatchProblem::Kind::kExplicit;
+    } else if (tokens[0] == "__all__") {
       THROW_IF(tokens.size() != 1, path << ":" << i + 1 << ": `__all__` takes no arguments");
       problem.kind = PatchMatchProblem::Kind::kAll;
     } else if (tokens[0] == "__auto__") {

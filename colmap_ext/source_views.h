@@ -25,7 +25,8 @@
 namespace hairmvs {
 
 struct SourceViewOptions {
-  // Upper bound on the sources of an `__auto__` problem (also caps `__auto__, N` of the cfg).
+  // Upper bound on the sources of a reference: caps `__auto__, N` of the cfg, and an explicit
+  // list or `__all__` keeps the views sharing the most sparse points with the reference.
   // A gantry T group's views share points only with each other (3 sources); handheld views
   // see 7-18 candidates, and more sources give the geometric pass more maps to agree with.
   // Measured (.geometric maps, 4 -> 6 -> 8): synth_handheld 74.5 -> 80.3 -> 81.7% covered,
@@ -61,7 +62,8 @@ struct SourceViewOptions {
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
     v("max_num_source_views", &max_num_source_views,
-      "most source views per reference for __auto__ (caps `__auto__, N` of patch-match.cfg)");
+      "most source views per reference (caps `__auto__, N` of patch-match.cfg; longer lists "
+      "and __all__ keep the views sharing the most sparse points)");
     v("min_triangulation_angle_deg", &min_triangulation_angle_deg,
       "75th percentile of shared points' triangulation angles must reach this (COLMAP: 1)");
     v("max_triangulation_angle_deg", &max_triangulation_angle_deg,

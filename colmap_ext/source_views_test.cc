@@ -126,6 +126,70 @@ TEST(SourceViews, TriangulationAngleTestsAndConfig) {
             std::string::npos);
 }
 
+// A list longer than max_num_source_views, explicit or __all__, keeps the views sharing the
+// most points (ties: the listed order), and the estimate and the geometric pass use just those.
+// Empty tokens are skipped, as COLMAP's CSVToVector skips them.
+TEST(SourceViews, LongListsKeepTheViewsSharingTheMostPoints) {
+  // ref sees all 40 points; o2 / o4 / o3 / o1 share 40 / 30 / 20 / 10 of them with it.
+  std::vector<unsigned> visibility;
+  for (int k = 0; k < 40; ++k) {
+    visibility.push_back(1u | (k < 10 ? 2u : 0u) | 4u | (k < 20 ? 8u : 0u) | (k < 30 ? 16u : 0u));
+  }
+  const Reconstruction model =
+      MakeRig({{0, 0, 0}, {0.1, 0, 0}, {0.2, 0, 0}, {0.3, 0, 0}, {0.4, 0, 0}},
+              {"ref.png", "o1.png", "o2.png", "o3.png", "o4.png"}, visibility);
+  const std::string dir = MakeTestDir("long_lists");
+  WriteTestWorkspace(dir, model);
+  const Workspace ws = Workspace::Read(dir);
+  WriteFileAtomically(JoinPaths(dir, "stereo", "patch-match.cfg"), [](std::ostream& out) {
+    out << "ref.png\n o1.png, o2.png,, o3.png; o4.png, \no1.png\n__all__,\n"
+           "o2.png\n o3.png ,\no3.png\n , ;\n";
+  });
+  SourceViewOptions options;
+  options.max_num_source_views = 2;
+  const std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 3u);  // o3.png lists no source: dropped, as COLMAP drops it
+  EXPECT_EQ(s[0].reference, "ref.png");
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"o2.png", "o4.png"}));
+  EXPECT_EQ(s[0].shared_points, (std::vector<int>{40, 30}));
+  ASSERT_EQ(s[0].triangulation_angle_deg.size(), 2u);
+  ASSERT_EQ(s[0].epipolar_direction_deg.size(), 2u);
+  EXPECT_NE(s[0].reason.find("the 2 of 4 sharing the most sparse points kept"),
+            std::string::npos)
+      << s[0].reason;
+  EXPECT_EQ(s[1].reference, "o1.png");  // shares 10 points with each: the listed order
+  EXPECT_EQ(s[1].sources, (std::vector<std::string>{"ref.png", "o2.png"}));
+  EXPECT_EQ(s[2].reference, "o2.png");
+  EXPECT_EQ(s[2].sources, (std::vector<std::string>{"o3.png"}));
+  EXPECT_EQ(s[2].reason.find("kept"), std::string::npos) << s[2].reason;
+  options.max_num_source_views = 4;
+  EXPECT_EQ(SelectSourceViews(ws, options)[0].sources,
+            (std::vector<std::string>{"o1.png", "o2.png", "o3.png", "o4.png"}));
+}
+
+// Views wider than max_triangulation_angle_deg come last, also when the T group holds some.
+TEST(SourceViews, WideViewsOnlyWhenNoNarrowOneIsLeft) {
+  // A T group 0.1 m from c (2.9 degrees), a diagonal view 0.35 m away sharing all points, and a
+  // diagonal one 0.05 m away (1.4 degrees) sharing half.
+  std::vector<unsigned> visibility(40, 0b011111u);
+  for (int k = 0; k < 20; ++k) visibility[k] |= 0b100000u;
+  const Reconstruction model = MakeRig(
+      {{0, 0, 0}, {-0.1, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}, {0.25, 0.25, 0}, {0.035, -0.035, 0}},
+      {"c.png", "l.png", "r.png", "b.png", "wide.png", "narrow.png"}, visibility);
+  const Workspace ws = WriteAndRead("wide_last", model);
+  SourceViewOptions options;
+  options.max_triangulation_angle_deg = 2.0;  // the T group's views are wide too
+  options.max_num_source_views = 4;
+  std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_TRUE(s[0].gantry_t_group) << s[0].reason;
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"l.png", "r.png", "b.png", "narrow.png"}))
+      << s[0].reason;
+  options.max_num_source_views = 5;
+  s = SelectSourceViews(ws, options);
+  EXPECT_EQ(s[0].sources,
+            (std::vector<std::string>{"l.png", "r.png", "b.png", "narrow.png", "wide.png"}));
+}
+
 TEST(SourceViews, MalformedConfigLinesNameFileAndLine) {
   const Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}}, {"a.png", "b.png"}, {3, 3});
   const std::string dir = MakeTestDir("bad_cfg");
@@ -136,7 +200,6 @@ TEST(SourceViews, MalformedConfigLinesNameFileAndLine) {
       {"a.png\n__auto__, 3, 4\n", ":2: expected `__auto__, N`"},
       {"a.png\n__auto__, 0\n", ":2: `__auto__, N` needs a positive integer"},
       {"a.png\nb.png, c.png\n", ":2: Image with name `c.png` does not exist"},
-      {"a.png\nb.png,,\n", ":2: empty image name"},
       {"z.png\nb.png\n", ":1: Image with name `z.png`"},
       {"a.png\nb.png\nb.png\n", "reference b.png has no sources line"},
       {"a.png\na.png\n", ":2: reference a.png lists itself"},

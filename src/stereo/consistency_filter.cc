@@ -28,7 +28,7 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
                                      ConsistencyFilterStats* stats) {
   FloatMap filtered = ref.depth;
   const int width = ref.depth.Width(), height = ref.depth.Height();
-  int num_checked = 0, num_kept = 0;
+  int64_t num_checked = 0, num_kept = 0;
 #pragma omp parallel for schedule(dynamic, 8) reduction(+ : num_checked, num_kept)
   for (int row = 0; row < height; ++row) {
     for (int col = 0; col < width; ++col) {

@@ -5,6 +5,7 @@
 // whose depth is wrong (hair seen through gaps, matching on the wrong layer) rarely agree with
 // an independent estimate from another viewpoint.
 
+#include <cstdint>
 #include <vector>
 
 #include "src/core/float_map.h"
@@ -12,9 +13,10 @@
 
 namespace hairmvs {
 
+// 64-bit: a run sums them over all its views (hundreds of 24-Mpixel maps pass 2^31).
 struct ConsistencyFilterStats {
-  int num_checked = 0;  // valid pixels of the reference
-  int num_kept = 0;
+  int64_t num_checked = 0;  // valid pixels of the reference
+  int64_t num_kept = 0;
 };
 
 // COLMAP's forward-backward reprojection error: the point `world` (seen at image point

@@ -478,6 +478,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   }
   std::fflush(stdout);
   std::set<std::string> estimated;  // views whose depth map was estimated in this run
+  auto warn_no_sources = [](const std::string& name) {
+    LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
+                 << "view); no depth map written";
+  };
   Progress progress("orientation_stereo", static_cast<int>(to_estimate.size()));
   // One view's depth map, with the other views' maps as a prior in the geometric pass; nothing
   // when the view has no source views.
@@ -486,15 +490,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                            FirstEstimate* cache) -> std::optional<ViewEstimate> {
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
-      LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
-                   << "view); no depth map written";
+      warn_no_sources(name);
       return std::nullopt;
     }
     progress->Stage("orientation fields");
-    std::vector<std::string> source_names = it->second;
-    if (static_cast<int>(source_names.size()) > source_options.max_num_source_views) {
-      source_names.resize(source_options.max_num_source_views);
-    }
+    const std::vector<std::string>& source_names = it->second;  // capped by SelectSourceViews
     // Copies: the cache may evict while loading the sources.
     const StereoViewData ref = loader.Load(name);
     std::vector<StereoViewData> source_data;
@@ -628,6 +628,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     // with one round, a job of an array gives the map one process would).
     std::vector<std::string> to_filter;  // in the order of `names`
     for (const std::string& name : to_run) {
+      if (sources_of.count(name) == 0) {  // never estimated: the first pass said so
+        if (options.geom_consistency_only) warn_no_sources(name);
+        continue;
+      }
       if (options.geom_consistency_only || estimated.count(name) > 0 || resumed.count(name) > 0) {
         to_filter.push_back(name);
       }
@@ -645,15 +649,25 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     // The views whose maps a view's prior and filter read: its sources and, within
     // geom_consistency_max_view_angle_deg, the other views of this run looking the same way
     // (of this run: so that a job of an array, given its own views, reads no map that another
-    // job may or may not have written yet).
-    std::map<std::string, std::vector<std::string>> consistency_views_of = sources_of;
+    // job may or may not have written yet). Views without sources of their own (a
+    // patch-match.cfg listing only some references) never have a map: they are matched
+    // against, not read.
+    std::map<std::string, std::vector<std::string>> consistency_views_of;
+    for (const auto& [name, sources] : sources_of) {
+      std::vector<std::string>& views = consistency_views_of[name];
+      for (const std::string& source : sources) {
+        if (sources_of.count(source) > 0) views.push_back(source);
+      }
+    }
     if (options.geom_consistency_max_view_angle_deg > 0) {
       const std::set<std::string> in_run(names.begin(), names.end());
       for (const std::string& name : to_filter) {
         std::vector<std::string>& views = consistency_views_of[name];
         for (std::string& other : ViewsLookingTheSameWay(
                  workspace, name, views, options.geom_consistency_max_view_angle_deg)) {
-          if (in_run.count(other) > 0) views.push_back(std::move(other));
+          if (in_run.count(other) > 0 && sources_of.count(other) > 0) {
+            views.push_back(std::move(other));
+          }
         }
       }
     }
@@ -768,8 +782,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           (previous_consistent >= 0 &&
            consistent - previous_consistent < options.geom_consistency_min_gain);
       if (total.num_checked > 0) {
-        std::printf("  round %d: %.1f%% of %d depths consistent with the previous maps%s\n",
-                    round + 1, 100 * consistent, total.num_checked,
+        std::printf("  round %d: %.1f%% of %lld depths consistent with the previous maps%s\n",
+                    round + 1, 100 * consistent, static_cast<long long>(total.num_checked),
                     last_round ? ": the last round" : ": another round");
       } else {
         std::printf("  round %d: no depths checked (no other view has a map)%s\n", round + 1,
@@ -823,8 +837,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                                             options.geom_consistency_min_views, &stats);
       }
       if (filtered) {
-        std::printf("  %s: %d of %d depths consistent with the maps of %d other view(s)\n",
-                    name.c_str(), stats.num_kept, stats.num_checked,
+        std::printf("  %s: %lld of %lld depths consistent with the maps of %d other view(s)\n",
+                    name.c_str(), static_cast<long long>(stats.num_kept),
+                    static_cast<long long>(stats.num_checked),
                     static_cast<int>(others.size()));
       }
       WriteDepthAndNormals(workspace, name, "geometric", depth, K, options.write_png);

@@ -639,5 +639,33 @@ TEST(OrientationStereoWorkspace, GeometricPassAlsoReadsTheViewsLookingTheSameWay
   std::filesystem::remove_all(path);
 }
 
+// A patch-match.cfg may list only some references (COLMAP computes those alone): the others
+// are matched against but never have a map, so the geometric pass neither waits for their maps
+// nor asks for them.
+TEST(OrientationStereoWorkspace, ViewsThatAreNoReferenceAreSourcesOnly) {
+  const std::string path = MakeTestDir("stereo_some_references");
+  WriteWorkspace(path);
+  {
+    std::ofstream cfg(JoinPaths(path, "stereo", "patch-match.cfg"));
+    cfg << "v0.png\nv1.png, v2.png, v3.png\nv1.png\nv0.png, v2.png, v3.png\n"
+        << "v2.png\nv0.png, v1.png, v3.png\n";
+  }
+  const Workspace workspace = Workspace::Read(path);
+  OrientationStereoOptions options = PlaneOptions();
+  StageTimings timings;
+  ASSERT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 3);
+  EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v3.png", "photometric")));
+  EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v3.png", "geometric")));
+  // Every reference was estimated again with the other references' maps as a prior.
+  EXPECT_GT(timings.Get("geometric prior"), 0.0);
+  const FloatMap geometric = ReadMat(workspace.DepthMapPath("v0.png", "geometric"));
+  // The geometric pass alone over every image: v3 is passed over, not asked for.
+  options.geom_consistency_only = true;
+  EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 3);
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), geometric.Data());
+  EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v3.png", "geometric")));
+  std::filesystem::remove_all(path);
+}
+
 }  // namespace
 }  // namespace hairmvs
