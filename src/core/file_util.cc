@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 
 #include "src/core/logging.h"
@@ -167,23 +168,43 @@ void RenameOver(const std::string& tmp, const std::string& path) {
 
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool binary) {
-  CreateDirs(ParentPath(path));
-  const std::string tmp = TemporaryPathFor(path);
-  const TrackedTemporary tracked(tmp);
-  try {
-    std::ofstream out(tmp, binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
-    // errno says why the stream failed (the folder not writable, the disk full).
-    THROW_IF(!out, "Cannot write " << path << ": " << std::strerror(errno) << " (temporary "
-                                   << tmp << ")");
-    write(out);
-    out.flush();
-    THROW_IF(!out, "Write failed for " << path << ": " << std::strerror(errno));
-  } catch (...) {
+  WriteFilesAtomically({{path, write, binary}});
+}
+
+void WriteFilesAtomically(const std::vector<FileToWrite>& files) {
+  std::vector<std::string> tmps;
+  // Each temporary is tracked from before it is created until the last rename.
+  std::vector<std::unique_ptr<TrackedTemporary>> tracked;
+  auto remove_temporaries_from = [&tmps](size_t first) {
     std::error_code ec;
-    fs::remove(tmp, ec);
+    for (size_t i = first; i < tmps.size(); ++i) fs::remove(tmps[i], ec);
+  };
+  try {
+    for (const FileToWrite& file : files) {
+      CreateDirs(ParentPath(file.path));
+      tmps.push_back(TemporaryPathFor(file.path));
+      const std::string& tmp = tmps.back();
+      tracked.push_back(std::make_unique<TrackedTemporary>(tmp));
+      std::ofstream out(tmp, file.binary ? std::ios::binary | std::ios::trunc : std::ios::trunc);
+      // errno says why the stream failed (the folder not writable, the disk full).
+      THROW_IF(!out, "Cannot write " << file.path << ": " << std::strerror(errno)
+                                     << " (temporary " << tmp << ")");
+      file.write(out);
+      out.flush();
+      THROW_IF(!out, "Write failed for " << file.path << ": " << std::strerror(errno));
+    }
+  } catch (...) {
+    remove_temporaries_from(0);
     throw;
   }
-  RenameOver(tmp, path);
+  for (size_t i = 0; i < files.size(); ++i) {
+    try {
+      RenameOver(tmps[i], files[i].path);
+    } catch (...) {
+      remove_temporaries_from(i + 1);
+      throw;
+    }
+  }
 }
 
 void WritePathAtomically(const std::string& path,

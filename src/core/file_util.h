@@ -37,6 +37,19 @@ std::vector<std::string> SplitString(const std::string& s, const std::string& de
 // temporary file is removed and the exception propagates; `path` is untouched.
 void WriteFileAtomically(const std::string& path,
                          const std::function<void(std::ostream&)>& write, bool binary = true);
+// One file of WriteFilesAtomically: `write` fills the stream of `path`'s temporary.
+struct FileToWrite {
+  std::string path;
+  std::function<void(std::ostream&)> write;
+  bool binary = true;
+};
+// Writes files that are only valid together (a model's cameras, images and points3D) as a
+// unit: every temporary is written first, and only once all are complete are they renamed over
+// their targets, in order. If any `write` throws, every temporary is removed and the exception
+// propagates; no target is touched. The renames are the one step that is not atomic as a whole
+// (POSIX has no rename of several files): a rename that fails leaves the targets before it
+// replaced, and removes the temporaries left.
+void WriteFilesAtomically(const std::vector<FileToWrite>& files);
 // For writers that need a file name (OpenCV's imwrite): `write` receives a temporary path
 // with the same extension as `path`.
 void WritePathAtomically(const std::string& path,

@@ -92,6 +92,48 @@ TEST(FileUtil, InterruptHandlersLeaveIgnoredSignalsIgnored) {
       ::testing::ExitedWithCode(0), "");
 }
 
+// Files written as a unit: a writer that throws after another's temporary is complete leaves
+// every old target byte for byte and no temporary; once all writers succeed, all are replaced.
+TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
+  const std::string dir = TestDir("unit");
+  const std::string first = JoinPaths(dir, "cameras.bin");
+  const std::string second = JoinPaths(dir, "images.bin");
+  const std::string old_first("old\0cameras", 11), old_second = "old images\n";
+  WriteFileAtomically(first, [&](std::ostream& out) { out << old_first; });
+  WriteFileAtomically(second, [&](std::ostream& out) { out << old_second; });
+  EXPECT_THROW(WriteFilesAtomically({{first, [](std::ostream& out) { out << "new cameras"; }},
+                                     {second,
+                                      [](std::ostream& out) {
+                                        out << "half" << std::flush;
+                                        throw std::runtime_error("disk full");
+                                      }}}),
+               std::runtime_error);
+  EXPECT_EQ(ReadTextFile(first), old_first);
+  EXPECT_EQ(ReadTextFile(second), old_second);
+  EXPECT_EQ(NumFilesIn(dir), 2);
+
+  WriteFilesAtomically({{first, [](std::ostream& out) { out << "new cameras"; }},
+                        {second, [](std::ostream& out) { out << "new images"; }, false},
+                        {JoinPaths(dir, "sub", "points3D.bin"),
+                         [](std::ostream& out) { out << "new points"; }}});
+  EXPECT_EQ(ReadTextFile(first), "new cameras");
+  EXPECT_EQ(ReadTextFile(second), "new images");
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "sub", "points3D.bin")), "new points");
+  EXPECT_EQ(NumFilesIn(dir), 3);  // the two files and sub/
+
+  // A folder in the way of the first rename: it is named, the second target keeps its old
+  // bytes, and the second temporary does not stay behind.
+  const std::string folder = JoinPaths(dir, "folder.bin");
+  CreateDirs(folder);
+  const std::string message = testing_util::ErrorOf([&] {
+    WriteFilesAtomically({{folder, [](std::ostream& out) { out << "x"; }},
+                          {second, [](std::ostream& out) { out << "newer images"; }}});
+  });
+  EXPECT_NE(message.find("to " + folder + ": Is a directory"), std::string::npos) << message;
+  EXPECT_EQ(ReadTextFile(second), "new images");
+  EXPECT_EQ(NumFilesIn(dir), 4);
+}
+
 // A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
 TEST(FileUtil, FailedWriteSaysWhy) {
   const std::string dir = TestDir("failed_write");
