@@ -598,25 +598,26 @@ void ReadFile(const std::string& path,
   reader(in, path, r);
 }
 
+// Whether `dir` holds all three of cameras, images and points3D with the extension `ext`.
+bool HasModelFiles(const std::string& dir, const char* ext) {
+  for (const char* name : {"cameras", "images", "points3D"}) {
+    if (!ExistsFile(JoinPaths(dir, std::string(name) + ext))) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Reconstruction ReadReconstruction(const std::string& dir) {
   THROW_IF(!ExistsDir(dir), "Missing sparse model folder: " << dir);
-  const char* kNames[3] = {"cameras", "images", "points3D"};
-  auto all_exist = [&](const char* ext) {
-    for (const char* name : kNames) {
-      if (!ExistsFile(JoinPaths(dir, std::string(name) + ext))) return false;
-    }
-    return true;
-  };
   Reconstruction r;
   // COLMAP's rule: binary if all three .bin files exist, else text. rigs.* / frames.*
   // (COLMAP 3.12+) are ignored: images.* still holds every pose.
-  if (all_exist(".bin")) {
+  if (HasModelFiles(dir, ".bin")) {
     ReadFile(JoinPaths(dir, "cameras.bin"), ReadCamerasBinary, &r, true);
     ReadFile(JoinPaths(dir, "images.bin"), ReadImagesBinary, &r, true);
     ReadFile(JoinPaths(dir, "points3D.bin"), ReadPoints3DBinary, &r, true);
-  } else if (all_exist(".txt")) {
+  } else if (HasModelFiles(dir, ".txt")) {
     ReadFile(JoinPaths(dir, "cameras.txt"), ReadCamerasText, &r, false);
     ReadFile(JoinPaths(dir, "images.txt"), ReadImagesText, &r, false);
     ReadFile(JoinPaths(dir, "points3D.txt"), ReadPoints3DText, &r, false);
@@ -631,7 +632,7 @@ Reconstruction ReadReconstruction(const std::string& dir) {
                   << hint.str());
   }
   const std::string images_file =
-      JoinPaths(dir, all_exist(".bin") ? "images.bin" : "images.txt");
+      JoinPaths(dir, HasModelFiles(dir, ".bin") ? "images.bin" : "images.txt");
   for (const auto& [id, image] : r.images) {
     THROW_IF(!r.cameras.count(image.camera_id),
              images_file << ": image " << id << " (" << image.name << ") refers to camera "
@@ -642,25 +643,26 @@ Reconstruction ReadReconstruction(const std::string& dir) {
 
 void WriteReconstruction(const Reconstruction& reconstruction, const std::string& dir,
                          ModelFormat format) {
-  CreateDirs(dir);
-  if (format == ModelFormat::kBinary) {
-    WriteFileAtomically(JoinPaths(dir, "cameras.bin"),
-                        [&](std::ostream& out) { WriteCamerasBinary(reconstruction, out); });
-    WriteFileAtomically(JoinPaths(dir, "images.bin"),
-                        [&](std::ostream& out) { WriteImagesBinary(reconstruction, out); });
-    WriteFileAtomically(JoinPaths(dir, "points3D.bin"),
-                        [&](std::ostream& out) { WritePoints3DBinary(reconstruction, out); });
-  } else {
-    WriteFileAtomically(
-        JoinPaths(dir, "cameras.txt"),
-        [&](std::ostream& out) { WriteCamerasText(reconstruction, out); }, false);
-    WriteFileAtomically(
-        JoinPaths(dir, "images.txt"),
-        [&](std::ostream& out) { WriteImagesText(reconstruction, out); }, false);
-    WriteFileAtomically(
-        JoinPaths(dir, "points3D.txt"),
-        [&](std::ostream& out) { WritePoints3DText(reconstruction, out); }, false);
-  }
+  const bool binary = format == ModelFormat::kBinary;
+  // Readers take the binary model whenever all three .bin files exist (COLMAP's rule): a text
+  // model written beside them would be silently ignored, and deleting them is not ours to do.
+  THROW_IF(!binary && HasModelFiles(dir, ".bin"),
+           "Cannot write a text model to " << dir << ": it holds cameras.bin, images.bin and "
+                                              "points3D.bin, which COLMAP and hairmvs read "
+                                              "instead of text; remove them or write a binary "
+                                              "model");
+  using Writer = void (*)(const Reconstruction&, std::ostream&);
+  auto file = [&](const char* name, Writer write_binary, Writer write_text) {
+    const Writer write = binary ? write_binary : write_text;
+    return FileToWrite{JoinPaths(dir, std::string(name) + (binary ? ".bin" : ".txt")),
+                       [&reconstruction, write](std::ostream& out) { write(reconstruction, out); },
+                       binary};
+  };
+  // One unit: a failure in any file (an image name COLMAP cannot read, a full disk) leaves the
+  // old model whole rather than new cameras beside old images.
+  WriteFilesAtomically({file("cameras", WriteCamerasBinary, WriteCamerasText),
+                        file("images", WriteImagesBinary, WriteImagesText),
+                        file("points3D", WritePoints3DBinary, WritePoints3DText)});
 }
 
 }  // namespace hairmvs

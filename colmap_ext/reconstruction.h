@@ -98,8 +98,10 @@ enum class ModelFormat { kBinary, kText };
 // naming the file and the problem (missing, truncated, trailing bytes, unknown model id,
 // wrong parameter count, malformed line).
 Reconstruction ReadReconstruction(const std::string& dir);
-// Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, each file
-// atomically (temporary name, then rename).
+// Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, as one
+// unit (WriteFilesAtomically): if any file fails, the old model is left whole. Throws
+// hairmvs::Error naming `dir` for a text model where all three .bin files are (readers would
+// keep reading those).
 void WriteReconstruction(const Reconstruction& reconstruction, const std::string& dir,
                          ModelFormat format);
 

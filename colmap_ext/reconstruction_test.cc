@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <random>
 #include <set>
@@ -302,11 +303,73 @@ TEST(Reconstruction, FolderRoundTripAndFormatChoice) {
   // Both present: binary wins (COLMAP's rule); rigs/frames files are ignored.
   const std::string both = JoinPaths(dir, "both");
   WriteReconstruction(model, both, ModelFormat::kBinary);
-  Reconstruction other = MakePlaneModel();
-  WriteReconstruction(other, both, ModelFormat::kText);
+  // (A text model is not written over a binary one: its files are copied there.)
+  const std::string other = JoinPaths(dir, "other");
+  WriteReconstruction(MakePlaneModel(), other, ModelFormat::kText);
+  for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
+    CopyFileAtomically(JoinPaths(other, name), JoinPaths(both, name));
+  }
   WriteFileAtomically(JoinPaths(both, "rigs.bin"), [](std::ostream& out) { out << "junk"; });
   WriteFileAtomically(JoinPaths(both, "frames.txt"), [](std::ostream& out) { out << "junk"; });
   EXPECT_EQ(ReadReconstruction(both).cameras.size(), model.cameras.size());
+}
+
+int NumFilesIn(const std::string& dir) {
+  int num_files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++num_files;
+  }
+  return num_files;
+}
+
+// A model's three files are one unit: an image name that cannot be written (images.* is the
+// second file) leaves the old model whole, not a new cameras file beside the old images file.
+TEST(Reconstruction, FailedWriteLeavesTheOldModel) {
+  for (const ModelFormat format : {ModelFormat::kBinary, ModelFormat::kText}) {
+    const bool binary = format == ModelFormat::kBinary;
+    const std::string dir = MakeTestDir(binary ? "unit_bin" : "unit_txt");
+    const Reconstruction model = MakePlaneModel();
+    WriteReconstruction(model, dir, format);
+    const std::string ext = binary ? ".bin" : ".txt";
+    std::vector<std::string> old_bytes;
+    for (const char* name : {"cameras", "images", "points3D"}) {
+      old_bytes.push_back(ReadTextFile(JoinPaths(dir, name + ext)));
+    }
+    Reconstruction changed = ModelWithEveryCameraModel();
+    changed.images.begin()->second.name = "my photo.png";
+    ExpectErrorMentions([&] { WriteReconstruction(changed, dir, format); },
+                        {"my photo.png", "no whitespace"});
+    int i = 0;
+    for (const char* name : {"cameras", "images", "points3D"}) {
+      EXPECT_TRUE(ReadTextFile(JoinPaths(dir, name + ext)) == old_bytes[i++])
+          << name << ext << " was replaced";
+    }
+    EXPECT_EQ(NumFilesIn(dir), 3);
+    ExpectModelsEqual(model, ReadReconstruction(dir));
+  }
+}
+
+// A text model written where a binary one is would be ignored (readers prefer binary): it is
+// refused, naming the folder and why, and the binary model is left as it is.
+TEST(Reconstruction, TextModelOverABinaryOneIsRefused) {
+  const std::string dir = MakeTestDir("text_over_binary");
+  const Reconstruction model = MakePlaneModel();
+  WriteReconstruction(model, dir, ModelFormat::kBinary);
+  const std::string old_images = ReadTextFile(JoinPaths(dir, "images.bin"));
+  ExpectErrorMentions([&] { WriteReconstruction(model, dir, ModelFormat::kText); },
+                      {"text model", dir, "cameras.bin, images.bin and points3D.bin"});
+  EXPECT_TRUE(ReadTextFile(JoinPaths(dir, "images.bin")) == old_images);
+  EXPECT_EQ(NumFilesIn(dir), 3);
+  // A binary model over a text one takes over (the stale text files are ignored), and a text
+  // model beside an incomplete binary one is read.
+  const std::string text_dir = MakeTestDir("binary_over_text");
+  WriteReconstruction(MakePlaneModel(), text_dir, ModelFormat::kText);
+  WriteReconstruction(ModelWithEveryCameraModel(), text_dir, ModelFormat::kBinary);
+  ExpectModelsEqual(ModelWithEveryCameraModel(), ReadReconstruction(text_dir));
+  std::filesystem::remove(JoinPaths(dir, "points3D.bin"));
+  WriteReconstruction(ModelWithEveryCameraModel(), dir, ModelFormat::kText);
+  ExpectModelsEqual(ModelWithEveryCameraModel(), ReadReconstruction(dir));
 }
 
 TEST(Reconstruction, MissingModelFiles) {
