@@ -116,15 +116,16 @@ CostVolume ReadCostVolume(const std::string& path, const std::string& depths_pat
 void WriteCostVolume(const std::string& path, const std::string& depths_path,
                      const CostVolume& volume) {
   CHECK_EQ(static_cast<int>(volume.label_depths.size()), volume.cost.Channels());
-  WriteMat(path, volume.cost);
-  WriteFileAtomically(
-      depths_path,
-      [&volume](std::ostream& out) {
-        out << "# depth (m) of each label (channel) of the cost volume, one per line\n"
-            << std::setprecision(9);
-        for (const double depth : volume.label_depths) out << depth << "\n";
-      },
-      false);
+  // One unit: ReadCostVolume refuses a Mat beside depths of another number of labels.
+  WriteFilesAtomically(
+      {{path, [&volume](std::ostream& out) { WriteMat(out, volume.cost); }},
+       {depths_path,
+        [&volume](std::ostream& out) {
+          out << "# depth (m) of each label (channel) of the cost volume, one per line\n"
+              << std::setprecision(9);
+          for (const double depth : volume.label_depths) out << depth << "\n";
+        },
+        false}});
 }
 
 }  // namespace hairmvs

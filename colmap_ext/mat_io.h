@@ -39,7 +39,8 @@ struct CostVolume {
 // Throws hairmvs::Error naming the file for: a missing file, a malformed Mat, a line that is
 // not a positive number, or a number of depths other than the Mat's channels.
 CostVolume ReadCostVolume(const std::string& path, const std::string& depths_path);
-// Writes both files atomically. CHECKs that there is one depth per channel.
+// Writes both files as one unit (WriteFilesAtomically). CHECKs that there is one depth per
+// channel.
 void WriteCostVolume(const std::string& path, const std::string& depths_path,
                      const CostVolume& volume);
 

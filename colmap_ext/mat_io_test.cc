@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -65,6 +66,37 @@ TEST(MatIo, ShapeFromTheHeaderCheckedAgainstTheFileSize) {
     EXPECT_NE(shape_error, "(no error)");
   }
   EXPECT_NE(testing_util::ErrorOf([] { ReadMatShape("/nonexistent/o.bin"); }), "(no error)");
+}
+
+// The Mat and its depths are one unit: depths that cannot be written (the disk full) leave the
+// old Mat, not a new one beside depths of another number of labels.
+TEST(MatIo, FailedDepthsLeaveTheOldCostVolume) {
+  const std::string dir = testing_util::MakeTestDir("cost_volume_unit");
+  const std::string path = JoinPaths(dir, "v.coarse.bin");
+  const std::string depths = JoinPaths(dir, "v.coarse.depths.txt");
+  CostVolume old_volume;
+  old_volume.cost = FloatMap(1, 1, 2, 1.0f);
+  old_volume.label_depths = {0.5, 0.6};
+  WriteCostVolume(path, depths, old_volume);
+  const std::string old_mat = ReadTextFile(path), old_depths = ReadTextFile(depths);
+  // 400 labels: a Mat of 1.6 kB and depths of 11 bytes each, 4.5 kB.
+  CostVolume volume;
+  volume.cost = FloatMap(1, 1, 400, 0.5f);
+  for (int k = 0; k < 400; ++k) volume.label_depths.push_back(1 + std::sqrt(k + 2.0) / 100);
+  {
+    const testing_util::FileSizeLimit disk_full(3000);
+    const std::string message =
+        testing_util::ErrorOf([&] { WriteCostVolume(path, depths, volume); });
+    EXPECT_NE(message.find(depths), std::string::npos) << message;
+  }
+  EXPECT_TRUE(ReadTextFile(path) == old_mat) << "the Mat was replaced";
+  EXPECT_EQ(ReadTextFile(depths), old_depths);
+  int num_files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++num_files;
+  }
+  EXPECT_EQ(num_files, 2);
 }
 
 TEST(MatIo, CostVolumeRoundTripAndBadDepths) {

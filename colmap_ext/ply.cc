@@ -321,9 +321,10 @@ void WriteFusedVis(std::ostream& out, const std::vector<FusedPoint>& points) {
 }
 
 void WriteFusedPly(const std::string& ply_path, const std::vector<FusedPoint>& points) {
-  WriteFileAtomically(ply_path, [&](std::ostream& out) { WriteFusedPlyPoints(out, points); });
-  WriteFileAtomically(ply_path + ".vis",
-                      [&](std::ostream& out) { WriteFusedVis(out, points); });
+  // One unit: COLMAP's mesher CHECK-fails on a .vis of another point count than the PLY's.
+  WriteFilesAtomically(
+      {{ply_path, [&](std::ostream& out) { WriteFusedPlyPoints(out, points); }},
+       {ply_path + ".vis", [&](std::ostream& out) { WriteFusedVis(out, points); }}});
 }
 
 std::vector<FusedPoint> ReadFusedPlyPoints(std::istream& in, const std::string& source) {

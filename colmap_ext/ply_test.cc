@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 
 #include "colmap_ext/test_util.h"
@@ -68,6 +69,32 @@ TEST(FusedPly, RoundTripThroughFilesAndEmptyCloud) {
   WriteFusedPly(JoinPaths(dir, "empty.ply"), {});
   EXPECT_TRUE(ReadFusedPly(JoinPaths(dir, "empty.ply")).empty());
   EXPECT_EQ(ReadTextFile(JoinPaths(dir, "empty.ply.vis")).size(), 8u);
+}
+
+// fused.ply and fused.ply.vis are one unit: a .vis that cannot be written (the disk full)
+// leaves the old PLY, not a new one beside an old .vis of another point count.
+TEST(FusedPly, FailedVisLeavesTheOldPly) {
+  const std::string dir = testing_util::MakeTestDir("ply_unit");
+  const std::string path = JoinPaths(dir, "fused.ply");
+  WriteFusedPly(path, SomePoints(3));
+  const std::string old_ply = ReadTextFile(path), old_vis = ReadTextFile(path + ".vis");
+  // 100 points seen in 20 images: a PLY of 2.9 kB and a .vis of 8.4 kB.
+  std::vector<FusedPoint> points = SomePoints(100);
+  for (FusedPoint& p : points) p.visible_image_idxs.assign(20, 1);
+  {
+    const testing_util::FileSizeLimit disk_full(4096);
+    const std::string message = testing_util::ErrorOf([&] { WriteFusedPly(path, points); });
+    EXPECT_NE(message.find(path + ".vis"), std::string::npos) << message;
+  }
+  // EXPECT_TRUE: a failure does not print kilobytes of binary.
+  EXPECT_TRUE(ReadTextFile(path) == old_ply) << "fused.ply was replaced";
+  EXPECT_TRUE(ReadTextFile(path + ".vis") == old_vis) << "fused.ply.vis was replaced";
+  int num_files = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++num_files;
+  }
+  EXPECT_EQ(num_files, 2);
 }
 
 TEST(FusedPly, ReadsAsciiAndBigEndianWithOtherNames) {

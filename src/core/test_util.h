@@ -1,7 +1,12 @@
 #pragma once
-// Test helpers of the lowest layer (header-only): what every layer's tests use.
+// Test helpers of the lowest layer (header-only): what every layer's tests use: the message of
+// an error, a file size limit that makes writes fail as on a full disk.
 // colmap_ext/test_util.h adds the workspace and model helpers on top.
 
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <csignal>
 #include <string>
 
 #include "src/core/logging.h"
@@ -19,6 +24,30 @@ std::string ErrorOf(F&& f) {
   }
   return "(no error)";
 }
+
+// While it lives, a file that would grow past `max_bytes` fails to write (EFBIG), as on a full
+// disk: the soft RLIMIT_FSIZE, with SIGXFSZ ignored so that the write fails instead of the
+// signal ending the process. For tests of what a write failing half-way leaves behind.
+class FileSizeLimit {
+ public:
+  explicit FileSizeLimit(rlim_t max_bytes) {
+    getrlimit(RLIMIT_FSIZE, &previous_limit_);
+    rlimit limit = previous_limit_;
+    limit.rlim_cur = std::min(max_bytes, limit.rlim_max);  // RLIM_INFINITY is the largest
+    previous_handler_ = std::signal(SIGXFSZ, SIG_IGN);
+    setrlimit(RLIMIT_FSIZE, &limit);
+  }
+  ~FileSizeLimit() {
+    setrlimit(RLIMIT_FSIZE, &previous_limit_);
+    std::signal(SIGXFSZ, previous_handler_);
+  }
+  FileSizeLimit(const FileSizeLimit&) = delete;
+  FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+ private:
+  rlimit previous_limit_{};
+  void (*previous_handler_)(int) = SIG_DFL;
+};
 
 }  // namespace testing_util
 }  // namespace hairmvs
