@@ -52,10 +52,21 @@ std::ifstream OpenMat(const std::string& path) {
   return in;
 }
 
-}  // namespace
+// The header of the file `in` opened at `path`, checked against the file's size; `in` is left
+// at the payload.
+MatShape ReadMatHeaderCheckedAgainstFileSize(std::ifstream& in, const std::string& path) {
+  const MatShape shape = ReadMatHeader(in, path);
+  const std::streamsize header_bytes = in.tellg();
+  in.seekg(0, std::ios::end);
+  const std::streamsize payload = static_cast<std::streamsize>(in.tellg()) - header_bytes;
+  RequirePayloadBytes(shape, std::min(payload, PayloadBytes(shape)),
+                      payload > PayloadBytes(shape), path);
+  in.seekg(header_bytes);
+  return shape;
+}
 
-FloatMap ReadMat(std::istream& in, const std::string& source) {
-  const MatShape shape = ReadMatHeader(in, source);
+// W*H*C floats from `in`, which is at the payload.
+FloatMap ReadMatPayload(std::istream& in, const MatShape& shape, const std::string& source) {
   FloatMap map(shape.width, shape.height, shape.channels);
   in.read(reinterpret_cast<char*>(map.Data().data()), PayloadBytes(shape));
   // Before peek(), which resets gcount().
@@ -66,20 +77,23 @@ FloatMap ReadMat(std::istream& in, const std::string& source) {
   return map;
 }
 
+}  // namespace
+
+FloatMap ReadMat(std::istream& in, const std::string& source) {
+  return ReadMatPayload(in, ReadMatHeader(in, source), source);
+}
+
 FloatMap ReadMat(const std::string& path) {
   std::ifstream in = OpenMat(path);
-  return ReadMat(in, path);
+  // The size first: a corrupt header in a short file is "truncated", not an allocation of the
+  // terabytes it announces.
+  const MatShape shape = ReadMatHeaderCheckedAgainstFileSize(in, path);
+  return ReadMatPayload(in, shape, path);
 }
 
 MatShape ReadMatShape(const std::string& path) {
   std::ifstream in = OpenMat(path);
-  const MatShape shape = ReadMatHeader(in, path);
-  const std::streamsize header_bytes = in.tellg();
-  in.seekg(0, std::ios::end);
-  const std::streamsize payload = static_cast<std::streamsize>(in.tellg()) - header_bytes;
-  RequirePayloadBytes(shape, std::min(payload, PayloadBytes(shape)),
-                      payload > PayloadBytes(shape), path);
-  return shape;
+  return ReadMatHeaderCheckedAgainstFileSize(in, path);
 }
 
 void WriteMat(std::ostream& out, const FloatMap& map) {

@@ -13,7 +13,8 @@
 namespace hairmvs {
 
 // Throws hairmvs::Error naming `path` for a missing file, a malformed header, or a payload
-// that is shorter or longer than W*H*C floats.
+// that is shorter or longer than W*H*C floats (from a path, checked against the file's size
+// before the map is allocated).
 FloatMap ReadMat(const std::string& path);
 FloatMap ReadMat(std::istream& in, const std::string& source);
 // The dimensions of the Mat file at `path`, from its header, checked against the file's size:

@@ -68,6 +68,19 @@ TEST(MatIo, ShapeFromTheHeaderCheckedAgainstTheFileSize) {
   EXPECT_NE(testing_util::ErrorOf([] { ReadMatShape("/nonexistent/o.bin"); }), "(no error)");
 }
 
+// A corrupt header in a short file is a truncated file named by its path, found from the file's
+// size before the 57.6 TB the header announces are allocated.
+TEST(MatIo, ShortFileWithAHugeHeaderIsTruncated) {
+  const std::string dir = testing_util::MakeTestDir("mat_huge_header");
+  const std::string path = JoinPaths(dir, "d.bin");
+  const std::string bytes = "60000&60000&4000&" + std::string(13, '\0');
+  ASSERT_EQ(bytes.size(), 30u);
+  WriteFileAtomically(path, [&](std::ostream& out) { out << bytes; });
+  const std::string message = testing_util::ErrorOf([&] { ReadMat(path); });
+  EXPECT_EQ(message.rfind(path + ": truncated Mat file", 0), 0u) << message;
+  EXPECT_NE(message.find("found 13"), std::string::npos) << message;
+}
+
 // The Mat and its depths are one unit: depths that cannot be written (the disk full) leave the
 // old Mat, not a new one beside depths of another number of labels.
 TEST(MatIo, FailedDepthsLeaveTheOldCostVolume) {
