@@ -24,10 +24,6 @@ int RunTemplateFusionCommand(int argc, char** argv) {
       "towards every depth map by an embedded deformation graph, plus the depth maps' detail.");
   parser.Add("workspace_path", &workspace_path, "dense workspace (COLMAP layout)", true);
   parser.AddSection("TemplateFusion", &options);
-  // Short forms used by the scripts.
-  parser.Add("write_intermediate", &options.write_intermediate,
-             "also write meshed-coarse-template.ply and meshed-refined-template.ply");
-  parser.Add("num_threads", &options.num_threads, "threads");
   if (!parser.Parse(argc, argv)) return 0;
   std::string error;
   THROW_IF(!options.Check(&error), "invalid option: " << error);

@@ -169,6 +169,7 @@ int RunPipeline(int argc, char** argv) {
     std::fprintf(stderr, "[pipeline] evaluation against %s\n", ground_truth_path.c_str());
     DepthEvaluationOptions depth_options;
     depth_options.image_names = image_names;
+    depth_options.depth_type = stereo_options.FinalMapType();  // what the stereo stage wrote
     const MeshEvaluationOptions mesh_options;
     // The true strands are indexed once for both evaluations (at the finer of the two spacings).
     std::unique_ptr<StrandDistance> strands;

@@ -21,6 +21,10 @@ struct OptionParser::Impl {
   std::map<std::string, std::function<std::string()>> printers;
   std::map<std::string, std::function<bool(const std::string&)>> converters;
   std::map<std::string, std::string> ignored;
+  // The option each typed variable is bound to: boost's notify() stores every option's value,
+  // defaults too, so a second option on one variable would overwrite a value given to the
+  // first with its own default.
+  std::map<const void*, std::string> typed_targets;
 };
 
 OptionParser::OptionParser(std::string command, std::string description)
@@ -52,6 +56,9 @@ std::string JoinNames(const std::vector<std::string>& values) {
 #define HAIRMVS_ADD_TYPED_OPTION(TYPE)                                                      \
   void OptionParser::Add(const std::string& name, TYPE* value, const std::string& help,   \
                          bool required) {                                                  \
+    const auto [bound, inserted] = impl_->typed_targets.emplace(value, name);             \
+    THROW_IF(!inserted, "hairmvs " << impl_->command << ": --" << name << " and --"        \
+                                   << bound->second << " are bound to one variable");     \
     auto* semantic = po::value<TYPE>(value);                                               \
     if (required) semantic->required();                                                    \
     else semantic->default_value(*value, ToText(*value));                                  \

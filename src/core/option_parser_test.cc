@@ -4,6 +4,7 @@
 
 #include "src/core/enum_names.h"
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
@@ -99,6 +100,20 @@ TEST(OptionParser, MissingRequiredOptionIsAnError) {
   std::vector<std::string> args = {"hairmvs", "toy"};
   auto argv = Argv(args);
   EXPECT_THROW(parser.Parse(static_cast<int>(argv.size()), argv.data()), Error);
+}
+
+// boost stores every option's value at notify(), defaults too: a second option on one variable
+// would overwrite what was given to the first (template_fusion's --num_threads did so to
+// --TemplateFusion.num_threads). Binding one twice is refused when the parser is built.
+TEST(OptionParser, OneVariableIsBoundToOneOption) {
+  ToyOptions options;
+  OptionParser parser("toy", "a toy command");
+  parser.AddSection("Toy", &options);
+  const std::string error = testing_util::ErrorOf(
+      [&] { parser.Add("num_levels", &options.num_levels, "short form"); });
+  EXPECT_NE(error.find("--num_levels and --Toy.num_levels are bound to one variable"),
+            std::string::npos)
+      << error;
 }
 
 }  // namespace

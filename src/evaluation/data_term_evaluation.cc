@@ -165,7 +165,7 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
 
 bool DataTermEvaluationOptions::Check(std::string* error) const {
   if (!(min_hair_fraction > 0 && min_hair_fraction <= 1)) {
-    *error = "EvaluateDataTerm.min_hair_fraction must be in (0, 1]";
+    *error = "--min_hair_fraction must be in (0, 1]";
     return false;
   }
   return CheckImageNames(image_names, error);

@@ -156,27 +156,27 @@ std::string TableRow(const DepthMetrics& m) {
 
 bool DepthEvaluationOptions::Check(std::string* error) const {
   if (depth_type != "geometric" && depth_type != "photometric") {
-    *error = "EvaluateDepth.depth_type must be geometric or photometric";
+    *error = "--depth_type must be geometric or photometric";
     return false;
   }
   if (!(error_image_max_mm > 0)) {
-    *error = "EvaluateDepth.error_image_max_mm must be > 0";
+    *error = "--error_image_max_mm must be > 0";
     return false;
   }
   if (max_points_3d_per_view < 0) {
-    *error = "EvaluateDepth.max_points_3d_per_view must be >= 0";
+    *error = "--max_points_3d_per_view must be >= 0";
     return false;
   }
   if (silhouette_band_px < 0) {
-    *error = "EvaluateDepth.silhouette_band_px must be >= 0";
+    *error = "--silhouette_band_px must be >= 0";
     return false;
   }
   if (layer_window_px < 0 || (layer_window_px > 0 && layer_window_px % 2 == 0)) {
-    *error = "EvaluateDepth.layer_window_px must be 0 or odd";
+    *error = "--layer_window_px must be 0 or odd";
     return false;
   }
   if (!(strand_spacing_m > 0)) {
-    *error = "EvaluateDepth.strand_spacing_m must be > 0";
+    *error = "--strand_spacing_m must be > 0";
     return false;
   }
   return CheckImageNames(image_names, error);

@@ -113,8 +113,7 @@ StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt
                         const std::string& name, int width, int height) {
   const std::string path = GroundTruthCamerasPath(gt_path);
   const int i = cameras.Find(name);
-  THROW_IF(i < 0,
-           path << ": no camera named " << name << " (or evaluate with --in_true_cameras 0)");
+  THROW_IF(i < 0, path << ": no camera named " << name);
   THROW_IF(cameras.width != width || cameras.height != height,
            path << ": cameras of " << cameras.width << " x " << cameras.height << " px, but "
                 << GroundTruthViewPath(gt_path, name) << " is " << width << " x " << height);

@@ -57,8 +57,8 @@ GroundTruthCameras ReadTrueCameras(const std::string& gt_path, bool in_true_came
 // The camera `name` was rendered with (gt_path/cameras.npz, read into `cameras`), on the true
 // maps' grid of width x height: how the evaluators carry a depth between the workspace's
 // camera (ViewCamera), in which the maps are estimated, and the true camera
-// (DepthEvaluationOptions::in_true_cameras). Throws hairmvs::Error naming the file when the
-// camera is absent or of another size.
+// (DepthEvaluationOptions::in_true_cameras), and how evaluate_mesh back-projects the true
+// maps. Throws hairmvs::Error naming the file when the camera is absent or of another size.
 StereoCamera TrueCamera(const GroundTruthCameras& cameras, const std::string& gt_path,
                         const std::string& name, int width, int height);
 

@@ -43,7 +43,7 @@ void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy)
   if (!copy) {
     THROW_IF(fs::exists(to), "Cannot link " << to << " to " << from
                                             << ": a folder of that name exists (use "
-                                               "--ImportGroundTruth.copy_images 1 or remove it)");
+                                               "--copy_images 1 or remove it)");
     fs::create_directory_symlink(fs::absolute(from), to, ec);
     THROW_IF(ec, "Cannot create the symlink " << to << " -> " << from << ": " << ec.message());
     return;
@@ -100,11 +100,11 @@ void UseTrueCameraPoses(const std::string& ground_truth_path,
 
 bool ImportGroundTruthOptions::Check(std::string* error) const {
   if (!(noise_m >= 0)) {
-    *error = "ImportGroundTruth.noise_m must be >= 0";
+    *error = "--noise_m must be >= 0";
     return false;
   }
   if (median_filter_px < 0 || (median_filter_px > 0 && median_filter_px % 2 == 0)) {
-    *error = "ImportGroundTruth.median_filter_px must be 0 or odd";
+    *error = "--median_filter_px must be 0 or odd";
     return false;
   }
   return CheckImageNames(image_names, error);
@@ -162,7 +162,8 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   ImportGroundTruthResult result;
   result.output_path = output_path;
   std::mt19937 rng(options.seed);
-  std::normal_distribution<double> noise(0.0, options.noise_m);
+  // Drawn from only when noise_m > 0; the standard asks for a positive deviation regardless.
+  std::normal_distribution<double> noise(0.0, options.noise_m > 0 ? options.noise_m : 1.0);
   size_t kept = 0, total = 0;
   Progress progress("import_ground_truth", static_cast<int>(names.size()));
   for (const std::string& name : names) {

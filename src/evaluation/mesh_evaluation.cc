@@ -16,6 +16,7 @@
 #include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/core/progress.h"
 #include "src/core/timer.h"
 #include "src/evaluation/depth_evaluation.h"
 #include "src/evaluation/evaluation_util.h"
@@ -41,19 +42,19 @@ std::string Line(const std::string& what, const DistanceStats& s) {
 
 bool MeshEvaluationOptions::Check(std::string* error) const {
   if (!(face_sample_spacing_m >= 0)) {
-    *error = "EvaluateMesh.face_sample_spacing_m must be >= 0";
+    *error = "--face_sample_spacing_m must be >= 0";
     return false;
   }
   if (!(surface_sample_spacing_m > 0)) {
-    *error = "EvaluateMesh.surface_sample_spacing_m must be > 0";
+    *error = "--surface_sample_spacing_m must be > 0";
     return false;
   }
   if (max_ground_truth_points <= 0) {
-    *error = "EvaluateMesh.max_ground_truth_points must be > 0";
+    *error = "--max_ground_truth_points must be > 0";
     return false;
   }
   if (!(strand_spacing_m > 0)) {
-    *error = "EvaluateMesh.strand_spacing_m must be > 0";
+    *error = "--strand_spacing_m must be > 0";
     return false;
   }
   return true;
@@ -103,7 +104,8 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   result.num_faces = static_cast<long>(mesh.faces.size());
   std::mt19937 rng(options.seed);
 
-  // Accuracy: mesh to the true strands.
+  Progress progress("evaluate_mesh", 3);
+  progress.Start(0, "accuracy: the mesh to the true strands");
   std::vector<Eigen::Vector3d> vertices;
   for (const Eigen::Vector3f& v : mesh.vertices) vertices.push_back(v.cast<double>());
   result.accuracy_vertices = SummarizeDistances(strand_distance.Distances(vertices));
@@ -118,20 +120,19 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   const GroundTruthCameras cameras = ReadGroundTruthCameras(ground_truth_path);
   std::vector<std::string> names = cameras.names;
   if (!workspace_path.empty()) names = Workspace::Read(workspace_path).ImageNames();
+  progress.Start(1, "the visible true hair of " + std::to_string(names.size()) + " views");
   std::vector<Eigen::Vector3f> surface;
   for (const std::string& name : names) {
-    const int i = cameras.Find(name);
-    THROW_IF(i < 0, "Image " << name << " has no camera in "
-                             << GroundTruthCamerasPath(ground_truth_path));
     const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
+    const StereoCamera camera =
+        TrueCamera(cameras, ground_truth_path, name, view.depth.Width(), view.depth.Height());
     for (int r = 0; r < view.depth.Height(); ++r) {
       for (int c = 0; c < view.depth.Width(); ++c) {
         const float d = view.depth.At(r, c);
         if (view.label[static_cast<size_t>(r) * view.depth.Width() + c] != kLabelHair || !(d > 0)) {
           continue;
         }
-        surface.push_back(
-            BackProjectPixelToWorld(cameras.K, cameras.R[i], cameras.t[i], c, r, d).cast<float>());
+        surface.push_back(camera.BackProject(c, r, d).cast<float>());
       }
     }
   }
@@ -140,6 +141,8 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
     std::shuffle(surface.begin(), surface.end(), rng);
     surface.resize(options.max_ground_truth_points);
   }
+  progress.Start(2, "completeness: " + std::to_string(surface.size()) +
+                        " true surface points to the mesh");
   std::vector<Eigen::Vector3d> queries;
   for (const Eigen::Vector3f& p : surface) queries.push_back(p.cast<double>());
   const TriangleMeshDistance mesh_distance(mesh, options.surface_sample_spacing_m);
@@ -152,6 +155,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   result.completeness_2mm = static_cast<double>(within2) / completeness.size();
   result.completeness_5mm = static_cast<double>(within5) / completeness.size();
   result.completeness_distance = SummarizeDistances(completeness);
+  progress.Finish();
 
   result.json_path = options.output_json;
   if (result.json_path.empty()) {

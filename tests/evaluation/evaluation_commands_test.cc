@@ -570,6 +570,19 @@ TEST(EvaluationCommands, EvaluateMesh) {
   EXPECT_DOUBLE_EQ(off.completeness_5mm, 1.0);
   EXPECT_TRUE(ExistsFile(JoinPaths(scene.workspace, "stereo", "evaluation",
                                    "mesh_evaluation.json")));
+
+  // True cameras of another size than the true maps would back-project the visible hair to
+  // the wrong place: named, as the depth evaluation names them.
+  GroundTruthCameras resized = scene.cameras;
+  resized.width *= 2;
+  resized.height *= 2;
+  WriteGroundTruthCameras(scene.gt, resized);
+  const std::string error =
+      testing_util::ErrorOf([&] { EvaluateMesh(on_plane, scene.gt, "", options); });
+  EXPECT_NE(error.find(JoinPaths(scene.gt, "cameras.npz") + ": cameras of " +
+                       std::to_string(resized.width) + " x " + std::to_string(resized.height)),
+            std::string::npos)
+      << error;
 }
 
 }  // namespace

@@ -1,0 +1,109 @@
+// The hairmvs executable, run as a user runs it: what only the binary shows (the command table,
+// each command's option parser, the pipeline's wiring of one stage's options into the next).
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "colmap_ext/test_util.h"
+#include "src/core/file_util.h"
+
+namespace hairmvs {
+namespace {
+
+struct CommandOutput {
+  int exit_code = -1;
+  std::string text;  // stdout and stderr
+};
+
+// Runs `hairmvs <args>`.
+CommandOutput RunHairmvs(const std::string& args) {
+  const std::string command = std::string("'") + HAIRMVS_EXECUTABLE + "' " + args + " 2>&1";
+  CommandOutput output;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return output;
+  char buffer[4096];
+  size_t n;
+  while ((n = fread(buffer, 1, sizeof(buffer), pipe)) > 0) output.text.append(buffer, n);
+  const int status = pclose(pipe);
+  output.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return output;
+}
+
+// The command names that `hairmvs help` lists.
+std::vector<std::string> CommandNames() {
+  std::istringstream lines(RunHairmvs("help").text);
+  std::vector<std::string> names;
+  bool in_table = false;
+  for (std::string line; std::getline(lines, line);) {
+    if (line == "Commands:") {
+      in_table = true;
+    } else if (in_table && line.size() > 2 && line[0] == ' ') {
+      names.push_back(line.substr(2, line.find(' ', 2) - 2));
+    }
+  }
+  return names;
+}
+
+// Every command builds its parser (one that binds a variable to two options throws there)
+// and prints its help.
+TEST(Cli, EveryCommandPrintsItsHelp) {
+  const std::vector<std::string> names = CommandNames();
+  EXPECT_GE(names.size(), 13u);
+  for (const std::string& name : names) {
+    const CommandOutput output = RunHairmvs(name + " -h");
+    EXPECT_EQ(output.exit_code, 0) << name << ":\n" << output.text;
+    EXPECT_NE(output.text.find("Options:"), std::string::npos) << name << ":\n" << output.text;
+  }
+}
+
+// A value given on the command line is the one the command checks, and the check names the
+// option as the command spells it.
+TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
+  const std::string dir = testing_util::MakeTestDir("cli_options");
+  CommandOutput output =
+      RunHairmvs("template_fusion --workspace_path " + dir + " --TemplateFusion.num_threads 0");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("TemplateFusion.num_threads must be >= 1"), std::string::npos)
+      << output.text;
+  output = RunHairmvs("evaluate_depth --workspace_path " + dir + " --ground_truth_path " + dir +
+                      " --depth_type colour");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("invalid option: --depth_type must be geometric or photometric"),
+            std::string::npos)
+      << output.text;
+  output = RunHairmvs("evaluate_mesh --mesh m.ply --ground_truth_path " + dir +
+                      " --surface_sample_spacing_m 0");
+  EXPECT_NE(output.text.find("--surface_sample_spacing_m must be > 0"), std::string::npos)
+      << output.text;
+  std::filesystem::remove_all(dir);
+}
+
+// The pipeline evaluates the maps its stereo stage wrote: single-pass .photometric maps too.
+TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
+  const std::string dir = testing_util::MakeTestDir("cli_pipeline");
+  CommandOutput output = RunHairmvs("synthesize --output_path " + dir +
+                                    " --width 160 --num_strands 20000");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  const std::string workspace = JoinPaths(dir, "dense");
+  output = RunHairmvs("pipeline --workspace_path " + workspace + " --ground_truth_path " +
+                      JoinPaths(dir, "gt") + " --stages orientation,stereo" +
+                      " --OrientationStereo.geom_consistency 0" +
+                      " --OrientationStereo.single_pass_type photometric");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_TRUE(ExistsFile(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png.photometric.bin")));
+  EXPECT_FALSE(ExistsFile(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png.geometric.bin")));
+  const std::string summary = JoinPaths(workspace, "stereo", "evaluation", "depth_evaluation.json");
+  ASSERT_TRUE(ExistsFile(summary)) << output.text;
+  EXPECT_NE(ReadTextFile(summary).find("\"depth_type\": \"photometric\""), std::string::npos);
+  EXPECT_NE(output.text.find("overall"), std::string::npos) << output.text;
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hairmvs
