@@ -3,6 +3,7 @@
 #include <zip.h>
 
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -228,11 +229,19 @@ NpyArray ParseNpy(const char* bytes, size_t size, const std::string& source) {
   for (const std::string& item : SplitString(shape_text.substr(1, shape_text.size() - 2), ",")) {
     const std::string dim = StripWhitespace(item);
     if (dim.empty()) continue;
-    THROW_IF(dim.find_first_not_of("0123456789") != std::string::npos,
+    // 18 digits fit in 64 bits (std::stoull would throw out_of_range without the file's name).
+    THROW_IF(dim.find_first_not_of("0123456789") != std::string::npos || dim.size() > 18,
              source << ": malformed shape " << shape_text);
     array.shape.push_back(std::stoull(dim));
   }
-  const size_t payload = array.NumElements() * array.ItemSize();
+  // The product is checked as it grows: a corrupt shape must not wrap around to a size that
+  // the file happens to hold.
+  size_t payload = array.ItemSize();
+  for (size_t d : array.shape) {
+    THROW_IF(d != 0 && payload > std::numeric_limits<size_t>::max() / d,
+             source << ": shape " << shape_text << " is larger than any file");
+    payload *= d;
+  }
   THROW_IF(size - offset < payload, source << ": truncated .npy data: " << (size - offset)
                                            << " bytes, expected " << payload);
   THROW_IF(size - offset > payload, source << ": " << (size - offset - payload)

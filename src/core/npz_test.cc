@@ -164,6 +164,22 @@ TEST(Npz, ErrorsNameTheFile) {
   EXPECT_THROW(ParseNpy(npy.data(), npy.size() - 1, "short"), Error);
   const std::string longer = npy + "x";
   EXPECT_THROW(ParseNpy(longer.data(), longer.size(), "long"), Error);
+  // Shapes whose product wraps around 64 bits (here to 0, which an empty payload would match)
+  // or whose dimensions do not fit in 64 bits: named as such.
+  auto npy_of_shape = [](const std::string& shape) {
+    const std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': " + shape +
+                             ", }\n";
+    return std::string("\x93NUMPY\x01\x00", 8) + static_cast<char>(dict.size() & 0xff) +
+           static_cast<char>(dict.size() >> 8) + dict;
+  };
+  const std::string wraps = npy_of_shape("(4294967296, 4294967296)");
+  EXPECT_NE(ExpectThrowMessage([&] { ParseNpy(wraps.data(), wraps.size(), "wraps.npy"); })
+                .find("wraps.npy: shape (4294967296, 4294967296) is larger than any file"),
+            std::string::npos);
+  const std::string huge = npy_of_shape("(123456789012345678901,)");
+  EXPECT_NE(ExpectThrowMessage([&] { ParseNpy(huge.data(), huge.size(), "huge.npy"); })
+                .find("huge.npy: malformed shape"),
+            std::string::npos);
   // Unsupported dtype.
   std::string complex = npy;
   complex.replace(complex.find("<f4"), 3, "<c8");

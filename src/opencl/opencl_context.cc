@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
+#include <cstring>
 #include <set>
 #include <sstream>
 
@@ -258,8 +259,14 @@ cl::Program& OpenCLContext::BuildProgram(const std::string& source,
   if (it != programs_.end()) return it->second;
 
   cl::Program program(context_, source);
-  // -cl-std=CL1.2: the kernels are OpenCL C 1.2 whatever the device's newest version.
-  const std::string options = "-cl-std=CL1.2 " + build_options;
+  // -cl-std=CL1.2: the kernels are OpenCL C 1.2 whatever the device's newest version. Where
+  // the device can, divisions and square roots are correctly rounded, as on the host: OpenCL
+  // allows 2.5 ulp otherwise (many GPUs' default), and the MRF kernels are meant to give the
+  // CPU reference's labels exactly (a parabola crossing an ulp off can flip a near tie).
+  std::string options = "-cl-std=CL1.2 " + build_options;
+  if (device_.getInfo<CL_DEVICE_SINGLE_FP_CONFIG>() & CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT) {
+    options += " -cl-fp32-correctly-rounded-divide-sqrt";
+  }
   try {
     program.build(std::vector<cl::Device>{device_}, options.c_str());
   } catch (const cl::Error& e) {
@@ -281,8 +288,17 @@ cl::Program& OpenCLContext::BuildProgram(const std::string& source,
 }
 
 cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes) {
-  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
-                    std::max<size_t>(bytes, 4), const_cast<void*>(data));
+  // A buffer of 0 bytes is invalid: short data (an empty vector, whose data() may be null, or
+  // a single byte) is copied from a zero-padded block of the minimum size, not read beyond.
+  constexpr size_t kMinBytes = 4;
+  if (bytes < kMinBytes) {
+    unsigned char padded[kMinBytes] = {};
+    if (bytes > 0) std::memcpy(padded, data, bytes);
+    return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kMinBytes,
+                      padded);
+  }
+  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
+                    const_cast<void*>(data));
 }
 
 }  // namespace hairmvs

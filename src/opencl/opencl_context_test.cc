@@ -69,7 +69,32 @@ TEST(OpenCLContext, BuildFailureThrowsWithLog) {
     const std::string what = e.what();
     EXPECT_NE(what.find("build failed"), std::string::npos) << what;
     EXPECT_NE(what.find("undefined_name"), std::string::npos) << what;
+    // Divisions are correctly rounded where the device can, as on the host.
+    const bool correctly_rounded = context->Device().getInfo<CL_DEVICE_SINGLE_FP_CONFIG>() &
+                                   CL_FP_CORRECTLY_ROUNDED_DIVIDE_SQRT;
+    EXPECT_EQ(what.find("-cl-fp32-correctly-rounded-divide-sqrt") != std::string::npos,
+              correctly_rounded)
+        << what;
   }
+}
+
+// Data shorter than the 4 bytes a buffer needs (an empty array, whose data() may be null; one
+// byte) is padded with zeros, not read beyond; longer data is copied as it is.
+TEST(OpenCLContext, ReadOnlyBufferOfShortData) {
+  auto context = OpenCLContext::Create();
+  auto read_back = [&](const cl::Buffer& buffer) {
+    std::vector<unsigned char> bytes(buffer.getInfo<CL_MEM_SIZE>());
+    context->Queue().enqueueReadBuffer(buffer, CL_TRUE, 0, bytes.size(), bytes.data());
+    return bytes;
+  };
+  const std::vector<float> empty;
+  EXPECT_EQ(read_back(ReadOnlyBuffer(context.get(), empty)),
+            (std::vector<unsigned char>{0, 0, 0, 0}));
+  const unsigned char one_byte = 7;
+  EXPECT_EQ(read_back(ReadOnlyBuffer(context.get(), &one_byte, 1)),
+            (std::vector<unsigned char>{7, 0, 0, 0}));
+  const std::vector<unsigned char> six = {1, 2, 3, 4, 5, 6};
+  EXPECT_EQ(read_back(ReadOnlyBuffer(context.get(), six)), six);
 }
 
 TEST(OpenCLContext, DeviceSelection) {
