@@ -104,12 +104,7 @@ TEST(MatIo, FailedDepthsLeaveTheOldCostVolume) {
   }
   EXPECT_TRUE(ReadTextFile(path) == old_mat) << "the Mat was replaced";
   EXPECT_EQ(ReadTextFile(depths), old_depths);
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    (void)entry;
-    ++num_files;
-  }
-  EXPECT_EQ(num_files, 2);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);
 }
 
 TEST(MatIo, CostVolumeRoundTripAndBadDepths) {

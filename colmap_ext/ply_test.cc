@@ -89,12 +89,7 @@ TEST(FusedPly, FailedVisLeavesTheOldPly) {
   // EXPECT_TRUE: a failure does not print kilobytes of binary.
   EXPECT_TRUE(ReadTextFile(path) == old_ply) << "fused.ply was replaced";
   EXPECT_TRUE(ReadTextFile(path + ".vis") == old_vis) << "fused.ply.vis was replaced";
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    (void)entry;
-    ++num_files;
-  }
-  EXPECT_EQ(num_files, 2);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);
 }
 
 TEST(FusedPly, ReadsAsciiAndBigEndianWithOtherNames) {

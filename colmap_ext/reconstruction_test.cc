@@ -314,15 +314,6 @@ TEST(Reconstruction, FolderRoundTripAndFormatChoice) {
   EXPECT_EQ(ReadReconstruction(both).cameras.size(), model.cameras.size());
 }
 
-int NumFilesIn(const std::string& dir) {
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    (void)entry;
-    ++num_files;
-  }
-  return num_files;
-}
-
 // A model's three files are one unit: an image name that cannot be written (images.* is the
 // second file) leaves the old model whole, not a new cameras file beside the old images file.
 TEST(Reconstruction, FailedWriteLeavesTheOldModel) {
@@ -345,7 +336,7 @@ TEST(Reconstruction, FailedWriteLeavesTheOldModel) {
       EXPECT_TRUE(ReadTextFile(JoinPaths(dir, name + ext)) == old_bytes[i++])
           << name << ext << " was replaced";
     }
-    EXPECT_EQ(NumFilesIn(dir), 3);
+    EXPECT_EQ(testing_util::NumEntriesIn(dir), 3);
     ExpectModelsEqual(model, ReadReconstruction(dir));
   }
 }
@@ -360,7 +351,7 @@ TEST(Reconstruction, TextModelOverABinaryOneIsRefused) {
   ExpectErrorMentions([&] { WriteReconstruction(model, dir, ModelFormat::kText); },
                       {"text model", dir, "cameras.bin, images.bin and points3D.bin"});
   EXPECT_TRUE(ReadTextFile(JoinPaths(dir, "images.bin")) == old_images);
-  EXPECT_EQ(NumFilesIn(dir), 3);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 3);
   // A binary model over a text one takes over (the stale text files are ignored), and a text
   // model beside an incomplete binary one is read.
   const std::string text_dir = MakeTestDir("binary_over_text");

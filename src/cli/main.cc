@@ -8,6 +8,7 @@
 #include "src/cli/command_registry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/opencl/opencl_error.h"
 
 namespace hairmvs {
 
@@ -49,11 +50,11 @@ int main(int argc, char** argv) {
   }
   try {
     return it->second.run(argc, argv);
-  } catch (const std::exception& e) {  // hairmvs::Error and the others alike
+  } catch (const std::exception& e) {  // hairmvs::Error, OpenCL's and the others alike
     // What the command printed (its options, its progress) comes first, so that the error is
     // the last line of a log that captures both streams.
     std::fflush(stdout);
-    std::fprintf(stderr, "ERROR: %s\n", e.what());
+    std::fprintf(stderr, "ERROR: %s\n", hairmvs::DescribeException(e).c_str());
     return 1;
   }
 }

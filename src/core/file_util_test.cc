@@ -33,21 +33,7 @@ TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
                                    }),
                std::runtime_error);
   EXPECT_EQ(ReadTextFile(path), "first");
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(ParentPath(path))) {
-    (void)entry;
-    ++num_files;
-  }
-  EXPECT_EQ(num_files, 1);
-}
-
-int NumFilesIn(const std::string& dir) {
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    (void)entry;
-    ++num_files;
-  }
-  return num_files;
+  EXPECT_EQ(testing_util::NumEntriesIn(ParentPath(path)), 1);
 }
 
 // Interrupted in the middle of two nested writes (a stream and a named temporary), the process
@@ -68,14 +54,14 @@ TEST(FileUtil, InterruptRemovesTemporariesInFlight) {
               WriteFileAtomically(tmp_path, [](std::ostream& o) { o << "x"; });
               // kept.txt, its temporary, the named temporary and the latter's own one
               // (renamed over it already): 3 files, so both writes are in flight.
-              if (NumFilesIn(dir) != 3) std::_Exit(3);
+              if (testing_util::NumEntriesIn(dir) != 3) std::_Exit(3);
               std::raise(signal_number);
             });
           });
           std::_Exit(4);  // not reached: the signal ends the process
         },
         ::testing::KilledBySignal(signal_number), "");
-    EXPECT_EQ(NumFilesIn(dir), 1) << "signal " << signal_number;
+    EXPECT_EQ(testing_util::NumEntriesIn(dir), 1) << "signal " << signal_number;
     EXPECT_EQ(ReadTextFile(kept), "old");
   }
 }
@@ -110,7 +96,7 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
                std::runtime_error);
   EXPECT_EQ(ReadTextFile(first), old_first);
   EXPECT_EQ(ReadTextFile(second), old_second);
-  EXPECT_EQ(NumFilesIn(dir), 2);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);
 
   WriteFilesAtomically({{first, [](std::ostream& out) { out << "new cameras"; }},
                         {second, [](std::ostream& out) { out << "new images"; }, false},
@@ -119,7 +105,7 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
   EXPECT_EQ(ReadTextFile(first), "new cameras");
   EXPECT_EQ(ReadTextFile(second), "new images");
   EXPECT_EQ(ReadTextFile(JoinPaths(dir, "sub", "points3D.bin")), "new points");
-  EXPECT_EQ(NumFilesIn(dir), 3);  // the two files and sub/
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 3);  // the two files and sub/
 
   // A folder in the way of the first rename: it is named, the second target keeps its old
   // bytes, and the second temporary does not stay behind.
@@ -131,7 +117,7 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
   });
   EXPECT_NE(message.find("to " + folder + ": Is a directory"), std::string::npos) << message;
   EXPECT_EQ(ReadTextFile(second), "new images");
-  EXPECT_EQ(NumFilesIn(dir), 4);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 4);
 }
 
 // A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
@@ -151,12 +137,7 @@ TEST(FileUtil, FailedWriteSaysWhy) {
   EXPECT_NE(message.find("Cannot rename"), std::string::npos) << message;
   EXPECT_NE(message.find("to " + folder + ": Is a directory"), std::string::npos) << message;
   EXPECT_TRUE(ExistsDir(folder));
-  int num_files = 0;
-  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
-    (void)entry;
-    ++num_files;
-  }
-  EXPECT_EQ(num_files, 1);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 1);
 }
 
 // A folder this process may not write to is named before any work; a missing one is made.

@@ -1,12 +1,13 @@
 #pragma once
 // Test helpers of the lowest layer (header-only): what every layer's tests use: the message of
-// an error, a file size limit that makes writes fail as on a full disk.
+// an error, the entries of a folder, a file size limit that makes writes fail as on a full disk.
 // colmap_ext/test_util.h adds the workspace and model helpers on top.
 
 #include <sys/resource.h>
 
 #include <algorithm>
 #include <csignal>
+#include <filesystem>
 #include <string>
 
 #include "src/core/logging.h"
@@ -23,6 +24,17 @@ std::string ErrorOf(F&& f) {
     return e.what();
   }
   return "(no error)";
+}
+
+// How many entries `dir` holds (files, folders, hidden temporaries): what an atomic write
+// leaves behind.
+inline int NumEntriesIn(const std::string& dir) {
+  int num_entries = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    (void)entry;
+    ++num_entries;
+  }
+  return num_entries;
 }
 
 // While it lives, a file that would grow past `max_bytes` fails to write (EFBIG), as on a full

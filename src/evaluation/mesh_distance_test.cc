@@ -8,6 +8,7 @@
 #include <random>
 
 #include "colmap_ext/ply.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
@@ -96,6 +97,9 @@ TEST(MeshDistance, SurfaceSamplesFollowTheArea) {
     EXPECT_LE(p.x(), 0.01 + 1e-9);
     EXPECT_NEAR(p.z(), 0.0, 1e-12);
   }
+  // A spacing too fine for memory (1e12 samples of 1 cm^2) is an error, not an overflow.
+  const std::string error = testing_util::ErrorOf([&] { SampleMeshSurface(square, 1e-8, &rng); });
+  EXPECT_NE(error.find("use a larger sample spacing"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "kernels/embedded_kernels.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/opencl/opencl_error.h"
 
 namespace hairmvs {
 namespace {
@@ -117,6 +118,26 @@ void ResolveIncludesInText(const std::string& file, const std::string& text,
 }
 
 }  // namespace
+
+std::string DescribeException(const std::exception& e) {
+  const auto* error = dynamic_cast<const cl::Error*>(&e);
+  if (error == nullptr) return e.what();
+  std::ostringstream message;
+  message << "OpenCL call " << error->what() << " failed: " << OpenCLErrorString(error->err());
+  switch (error->err()) {
+    case CL_MEM_OBJECT_ALLOCATION_FAILURE:
+    case CL_OUT_OF_RESOURCES:
+    case CL_OUT_OF_HOST_MEMORY:
+    case CL_INVALID_BUFFER_SIZE:
+      message << ": the device ran out of memory, or a buffer exceeds its largest allocation "
+                 "(`hairmvs opencl_devices` lists both); a smaller "
+                 "--OrientationStereo.max_image_size or --OpenCL.device of another device";
+      break;
+    default:
+      break;
+  }
+  return message.str();
+}
 
 std::string OpenCLErrorString(cl_int code) {
   const char* name = "unknown error";

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "src/core/logging.h"
+#include "src/opencl/opencl_error.h"
 #include "src/opencl/opencl_options.h"
 
 namespace hairmvs {
@@ -76,6 +77,24 @@ TEST(OpenCLContext, BuildFailureThrowsWithLog) {
               correctly_rounded)
         << what;
   }
+}
+
+// A failed OpenCL call is described by its code, with what to do when memory ran out; other
+// exceptions by their message.
+TEST(OpenCLContext, FailedCallsAreDescribed) {
+  auto context = OpenCLContext::Create();
+  const cl_ulong max_alloc = context->Device().getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  try {
+    cl::Buffer too_large(context->Context(), CL_MEM_READ_WRITE, max_alloc + 4096);
+    ADD_FAILURE() << "a buffer beyond CL_DEVICE_MAX_MEM_ALLOC_SIZE was created";
+  } catch (const cl::Error& e) {
+    const std::string message = DescribeException(e);
+    EXPECT_NE(message.find("OpenCL call clCreateBuffer failed: CL_INVALID_BUFFER_SIZE (-61)"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("--OrientationStereo.max_image_size"), std::string::npos) << message;
+  }
+  EXPECT_EQ(DescribeException(Error("plain")), "plain");
 }
 
 // Data shorter than the 4 bytes a buffer needs (an empty array, whose data() may be null; one
