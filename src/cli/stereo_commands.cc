@@ -2,7 +2,7 @@
 // hairmvs patch_match_stereo: the same, behind colmap patch_match_stereo's command line.
 
 #include <cstdio>
-#include <limits>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,8 +92,8 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              "source views: minimum triangulation angle in degrees");
   parser.Add("PatchMatchStereo.geom_consistency", &geom_consistency,
              "write .photometric maps, then .geometric maps estimated again with the source "
-             "views' maps as a prior and filtered by consistency with them (0: the .geometric "
-             "maps are the unfiltered estimates)");
+             "views' maps as a prior and filtered by consistency with them (0: the "
+             ".photometric maps alone)");
   parser.Add("PatchMatchStereo.geom_consistency_max_cost", &geom_consistency_max_cost,
              "geometric pass: reprojection error in px at which the sources' depth maps, as a "
              "prior, cost the most");
@@ -103,7 +103,9 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              &filter_geom_consistency_max_cost,
              "largest forward-backward reprojection error in px for a view to agree");
   parser.Add("PatchMatchStereo.filter", &filter,
-             "drop low-confidence pixels and pixels at the ends of the depth range");
+             "drop low-confidence pixels, pixels at the ends of the depth range and (with "
+             "geom_consistency) pixels the other views' maps disagree with; 0 keeps every "
+             "estimate, the geometric pass still estimating with the sources' maps as a prior");
   parser.Add("config_path", &config_path,
              "patch-match.cfg to use instead of stereo/patch-match.cfg (as colmap's)");
   parser.AddSection("OrientationStereo", &options);
@@ -128,37 +130,63 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   parser.AddIgnored("PatchMatchStereo.cache_size", "views are cached by count, not size");
   parser.AddIgnored("PatchMatchStereo.allow_missing_files", "missing files are errors here");
   parser.AddIgnored("pmvs_option_name", "only --workspace_format COLMAP is supported");
+  // The options colmap gives every command.
+  parser.AddIgnored("project_path",
+                    "colmap's project .ini files are not read: give the options here");
+  parser.AddIgnored("random_seed", "the orientation stereo draws no random numbers");
+  parser.AddIgnored("log_to_stderr", "hairmvs logs to stderr always");
+  parser.AddIgnored("log_level", "hairmvs logs warnings and errors always");
   if (!parser.Parse(argc, argv)) return 0;
   THROW_IF(workspace_format != "COLMAP",
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
   if (parser.WasGiven("config_path")) source_options.config_path = config_path;
-  if (parser.WasGiven("PatchMatchStereo.max_image_size")) options.max_image_size = max_image_size;
-  if (parser.WasGiven("PatchMatchStereo.depth_min")) options.depth_min = depth_min;
-  if (parser.WasGiven("PatchMatchStereo.depth_max")) options.depth_max = depth_max;
-  if (parser.WasGiven("PatchMatchStereo.min_triangulation_angle")) {
-    source_options.min_triangulation_angle_deg = min_triangulation_angle;
+  // colmap's options and the fields they set: applied where given, and named in the error
+  // when a value they set is refused.
+  struct MappedOption {
+    const char* colmap_name;
+    const char* field;
+    std::function<void()> apply;
+  };
+  const std::vector<MappedOption> mapped = {
+      {"PatchMatchStereo.max_image_size", "max_image_size",
+       [&] { options.max_image_size = max_image_size; }},
+      {"PatchMatchStereo.depth_min", "depth_min", [&] { options.depth_min = depth_min; }},
+      {"PatchMatchStereo.depth_max", "depth_max", [&] { options.depth_max = depth_max; }},
+      {"PatchMatchStereo.min_triangulation_angle", "min_triangulation_angle_deg",
+       [&] { source_options.min_triangulation_angle_deg = min_triangulation_angle; }},
+      {"PatchMatchStereo.geom_consistency", "geom_consistency",
+       [&] { options.geom_consistency = geom_consistency; }},
+      {"PatchMatchStereo.geom_consistency_max_cost", "geom_prior_max_error_px",
+       [&] { options.geom_prior_max_error_px = geom_consistency_max_cost; }},
+      {"PatchMatchStereo.filter_min_num_consistent", "geom_consistency_min_views",
+       [&] { options.geom_consistency_min_views = filter_min_num_consistent; }},
+      {"PatchMatchStereo.filter_geom_consistency_max_cost", "geom_consistency_max_error_px",
+       [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
+  };
+  for (const MappedOption& option : mapped) {
+    if (parser.WasGiven(option.colmap_name)) option.apply();
   }
-  if (parser.WasGiven("PatchMatchStereo.geom_consistency")) {
-    options.geom_consistency = geom_consistency;
-  }
-  if (parser.WasGiven("PatchMatchStereo.geom_consistency_max_cost")) {
-    options.geom_prior_max_error_px = geom_consistency_max_cost;
-  }
-  if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent")) {
-    options.geom_consistency_min_views = filter_min_num_consistent;
-  }
-  if (parser.WasGiven("PatchMatchStereo.filter_geom_consistency_max_cost")) {
-    options.geom_consistency_max_error_px = filter_geom_consistency_max_cost;
-  }
-  // As colmap's: without its geometric pass the maps are named .photometric; with it but
-  // unfiltered (filter 0, below), .geometric.
+  // As colmap's: without its geometric pass the maps are named .photometric.
   if (!parser.WasGiven("OrientationStereo.single_pass_type")) {
     options.single_pass_type = options.geom_consistency ? "geometric" : "photometric";
   }
+  // As colmap's filter 0: every estimate is kept; with geom_consistency the geometric pass still
+  // estimates each view again with its sources' maps as a prior.
   if (!filter) {
-    options.geom_consistency = false;
     options.filter_range_ends = false;
-    options.min_confidence = -std::numeric_limits<double>::infinity();
+    options.min_confidence = 0;
+    options.geom_consistency_min_views = 0;
+  }
+  std::string options_error;
+  if (!options.Check(&options_error) || !source_options.Check(&options_error)) {
+    for (const MappedOption& option : mapped) {
+      if (parser.WasGiven(option.colmap_name) &&
+          options_error.find(option.field) != std::string::npos) {
+        options_error += std::string(" (") + option.field + " is set by --" +
+                         option.colmap_name + ")";
+      }
+    }
+    HAIRMVS_THROW("hairmvs patch_match_stereo: invalid options: " << options_error);
   }
   std::string error;
   THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);

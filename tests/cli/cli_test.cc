@@ -4,12 +4,14 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "colmap_ext/mat_io.h"
 #include "colmap_ext/test_util.h"
 #include "src/core/file_util.h"
 
@@ -102,6 +104,39 @@ TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
   ASSERT_TRUE(ExistsFile(summary)) << output.text;
   EXPECT_NE(ReadTextFile(summary).find("\"depth_type\": \"photometric\""), std::string::npos);
   EXPECT_NE(output.text.find("overall"), std::string::npos) << output.text;
+  std::filesystem::remove_all(dir);
+}
+
+// The drop-in for colmap patch_match_stereo: its filter 0 keeps every estimate (the geometric
+// pass still runs, as colmap's), a value it maps that the stereo refuses is named as the user
+// typed it, and the options colmap gives every command are accepted with a warning.
+TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
+  const std::string dir = testing_util::MakeTestDir("cli_patch_match");
+  CommandOutput output = RunHairmvs("synthesize --output_path " + dir +
+                                    " --width 160 --num_strands 20000");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  const std::string workspace = JoinPaths(dir, "dense");
+  const std::string run = "patch_match_stereo --workspace_path " + workspace +
+                          " --workspace_format COLMAP --OrientationStereo.skip_existing 0";
+  auto num_depths = [&](const std::string& type) {
+    const FloatMap map =
+        ReadMat(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png." + type + ".bin"));
+    return std::count_if(map.Data().begin(), map.Data().end(), [](float d) { return d > 0; });
+  };
+  output = RunHairmvs(run + " --log_to_stderr 1 --random_seed 3");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_NE(output.text.find("log_to_stderr"), std::string::npos) << output.text;
+  const long filtered = num_depths("geometric");
+  output = RunHairmvs(run + " --PatchMatchStereo.filter 0");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_NE(output.text.find("geometric consistency"), std::string::npos) << output.text;
+  const long unfiltered = num_depths("geometric");
+  EXPECT_GT(unfiltered, filtered);
+  output = RunHairmvs(run + " --PatchMatchStereo.max_image_size 0");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("(max_image_size is set by --PatchMatchStereo.max_image_size)"),
+            std::string::npos)
+      << output.text;
   std::filesystem::remove_all(dir);
 }
 
