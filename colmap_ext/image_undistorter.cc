@@ -223,10 +223,13 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
     for (float& value : mask.Data()) value = value > 0.5f ? 1.0f : 0.0f;  // 128 of 255 and up
     WriteImage(JoinPaths(thresholded, name + ".png"), mask);
   }
+  // One unit: a copy that fails (a full disk) leaves masks/ as it was, not half replaced.
+  std::vector<std::pair<std::string, std::string>> copies;
   for (const std::string& name : masked) {
-    CopyFileAtomically(JoinPaths(thresholded, name + ".png"), workspace_mask(name));
-    ++result.num_masks;
+    copies.emplace_back(JoinPaths(thresholded, name + ".png"), workspace_mask(name));
   }
+  CopyFilesAtomically(copies);
+  result.num_masks = static_cast<int>(copies.size());
   return result;
 }
 

@@ -102,7 +102,7 @@ namespace {
 // fixed buffers claimed with an atomic flag, so that the handler reads them without locks or
 // allocation (only async-signal-safe calls run there). A write that finds every slot taken is
 // simply not tracked: more than kNumSlots writes at once is far beyond this program's threads.
-constexpr int kNumSlots = 64;
+constexpr int kNumSlots = 256;  // a unit of WriteFilesAtomically holds one per file
 enum SlotState : int { kFree = 0, kClaimed = 1, kTracked = 2 };
 struct TemporarySlot {
   std::atomic<int> state{kFree};
@@ -224,8 +224,19 @@ void WritePathAtomically(const std::string& path,
 }
 
 void CopyFileAtomically(const std::string& from, const std::string& to) {
-  const std::string bytes = ReadTextFile(from);
-  WriteFileAtomically(to, [&bytes](std::ostream& out) { out.write(bytes.data(), bytes.size()); });
+  CopyFilesAtomically({{from, to}});
+}
+
+void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>& from_to) {
+  std::vector<FileToWrite> files;
+  for (const auto& [from, to] : from_to) {
+    // Read when its temporary is written: one file's bytes in memory at a time.
+    files.push_back({to, [from = from](std::ostream& out) {
+                       const std::string bytes = ReadTextFile(from);
+                       out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+                     }});
+  }
+  WriteFilesAtomically(files);
 }
 
 void RemoveTemporaryFilesOnInterrupt() {

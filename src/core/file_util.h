@@ -6,6 +6,7 @@
 #include <functional>
 #include <ostream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace hairmvs {
@@ -56,6 +57,8 @@ void WritePathAtomically(const std::string& path,
                          const std::function<void(const std::string& tmp_path)>& write);
 // `from`'s bytes written to `to` with WriteFileAtomically.
 void CopyFileAtomically(const std::string& from, const std::string& to);
+// Each pair's `from` copied to its `to` as one unit (WriteFilesAtomically).
+void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>& from_to);
 
 // Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
 // temporary files of the writes above still in flight, then let the signal end the process as

@@ -120,6 +120,27 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
   EXPECT_EQ(testing_util::NumEntriesIn(dir), 4);
 }
 
+// Copies as a unit (undistort_masks' masks): all are copied, empty files too, or, when a
+// source cannot be read, none, the source named.
+TEST(FileUtil, CopyFilesAtomicallyCopiesAllOrNone) {
+  const std::string dir = TestDir("copy_unit");
+  const std::string a = JoinPaths(dir, "a.png"), empty = JoinPaths(dir, "empty.png");
+  WriteFileAtomically(a, [](std::ostream& out) { out << std::string("\x89PNG\0x", 6); });
+  WriteFileAtomically(empty, [](std::ostream&) {});
+  const std::string to_a = JoinPaths(dir, "out", "a.png");
+  const std::string to_empty = JoinPaths(dir, "out", "empty.png");
+  CopyFilesAtomically({{a, to_a}, {empty, to_empty}});
+  EXPECT_EQ(ReadTextFile(to_a), std::string("\x89PNG\0x", 6));
+  EXPECT_EQ(ReadTextFile(to_empty), "");
+  const std::string message = testing_util::ErrorOf([&] {
+    CopyFilesAtomically({{empty, to_a}, {JoinPaths(dir, "missing.png"), to_empty}});
+  });
+  EXPECT_NE(message.find("Cannot open " + JoinPaths(dir, "missing.png")), std::string::npos)
+      << message;
+  EXPECT_EQ(ReadTextFile(to_a), std::string("\x89PNG\0x", 6));  // not replaced
+  EXPECT_EQ(testing_util::NumEntriesIn(JoinPaths(dir, "out")), 2);
+}
+
 // A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
 TEST(FileUtil, FailedWriteSaysWhy) {
   const std::string dir = TestDir("failed_write");
