@@ -37,13 +37,19 @@ start=$(date +%s)
   --OrientationStereo.write_cost_volume 1 "$@" > "$OUT/orientation_stereo.log" 2>&1 ||
   { tail -20 "$OUT/orientation_stereo.log" >&2; exit 1; }
 seconds=$(( $(date +%s) - start ))
-"$HAIRMVS" evaluate_depth --workspace_path "$OUT" --ground_truth_path "$SET/gt" \
-  --max_points_3d_per_view 3000 > "$OUT/evaluate_geometric.log" 2>&1
-"$HAIRMVS" evaluate_depth --workspace_path "$OUT" --ground_truth_path "$SET/gt" \
-  --max_points_3d_per_view 3000 --depth_type photometric \
-  --output_path "$OUT/stereo/evaluation_first_estimate" > "$OUT/evaluate_first_estimate.log" 2>&1
-"$HAIRMVS" evaluate_data_term --workspace_path "$OUT" --ground_truth_path "$SET/gt" \
-  > "$OUT/evaluate_data_term.log" 2>&1
+# Runs one evaluation into its log; on failure the log's end is shown, not a silent exit.
+evaluate() {
+  local log=$1
+  shift
+  "$HAIRMVS" "$@" > "$log" 2>&1 || { tail -20 "$log" >&2; exit 1; }
+}
+evaluate "$OUT/evaluate_geometric.log" evaluate_depth --workspace_path "$OUT" \
+  --ground_truth_path "$SET/gt" --max_points_3d_per_view 3000
+evaluate "$OUT/evaluate_first_estimate.log" evaluate_depth --workspace_path "$OUT" \
+  --ground_truth_path "$SET/gt" --max_points_3d_per_view 3000 --depth_type photometric \
+  --output_path "$OUT/stereo/evaluation_first_estimate"
+evaluate "$OUT/evaluate_data_term.log" evaluate_data_term --workspace_path "$OUT" \
+  --ground_truth_path "$SET/gt"
 if [ "${KEEP_COST_VOLUMES:-0}" != 1 ]; then rm -rf "$OUT/stereo/cost_volumes"; fi
 
 header=$(grep -m1 '^view ' "$OUT/evaluate_geometric.log")

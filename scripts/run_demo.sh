@@ -4,13 +4,24 @@
 # (orientation fields, orientation stereo, template fusion) and evaluates the depth maps and
 # the mesh against the ground truth. Everything goes to ./out/demo (override: $1).
 set -euo pipefail
+# $1 is taken from where the script is called, before it moves to the repository.
+OUT=$(realpath -m "${1:-$(dirname "$0")/../out/demo}")
 cd "$(dirname "$0")/.."
 # Only the command-line tool: the tests and benchmarks are built by scripts/run_tests.sh.
 bash scripts/build.sh hairmvs
-OUT=${1:-out/demo}
 HAIRMVS=./build/src/cli/hairmvs
 start=$(date +%s)
-rm -rf "$OUT"
+# A previous demo's output (a synthesised set has gt/meta.json) is replaced; any other folder is
+# left alone.
+if [ -e "$OUT" ]; then
+  if [ -f "$OUT/gt/meta.json" ] || [ -z "$(ls -A "$OUT")" ]; then
+    rm -rf "$OUT"
+  else
+    echo "run_demo.sh: $OUT exists and is not a previous demo's output (no gt/meta.json);" \
+         "give another folder" >&2
+    exit 1
+  fi
+fi
 # The generator's defaults (960 x 640, 100 000 strands): one T group of 4 views of curly hair.
 $HAIRMVS synthesize --output_path "$OUT" --style curly --rig gantry --num_groups 1
 $HAIRMVS pipeline --workspace_path "$OUT/dense" --ground_truth_path "$OUT/gt"
