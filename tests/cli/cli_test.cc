@@ -37,6 +37,15 @@ CommandOutput RunHairmvs(const std::string& args) {
   return output;
 }
 
+// A T group of views 160 px wide of sparse hair, with its truth, in `dir` (a few seconds);
+// returns its dense workspace.
+std::string SynthesizeSmallSet(const std::string& dir) {
+  const CommandOutput output =
+      RunHairmvs("synthesize --output_path " + dir + " --width 160 --num_strands 20000");
+  EXPECT_EQ(output.exit_code, 0) << output.text;
+  return JoinPaths(dir, "dense");
+}
+
 // The command names that `hairmvs help` lists.
 std::vector<std::string> CommandNames() {
   std::istringstream lines(RunHairmvs("help").text);
@@ -89,11 +98,8 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
 // The pipeline evaluates the maps its stereo stage wrote: single-pass .photometric maps too.
 TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
   const std::string dir = testing_util::MakeTestDir("cli_pipeline");
-  CommandOutput output = RunHairmvs("synthesize --output_path " + dir +
-                                    " --width 160 --num_strands 20000");
-  ASSERT_EQ(output.exit_code, 0) << output.text;
-  const std::string workspace = JoinPaths(dir, "dense");
-  output = RunHairmvs("pipeline --workspace_path " + workspace + " --ground_truth_path " +
+  const std::string workspace = SynthesizeSmallSet(dir);
+  CommandOutput output = RunHairmvs("pipeline --workspace_path " + workspace + " --ground_truth_path " +
                       JoinPaths(dir, "gt") + " --stages orientation,stereo" +
                       " --OrientationStereo.geom_consistency 0" +
                       " --OrientationStereo.single_pass_type photometric");
@@ -112,10 +118,8 @@ TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
 // typed it, and the options colmap gives every command are accepted with a warning.
 TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
   const std::string dir = testing_util::MakeTestDir("cli_patch_match");
-  CommandOutput output = RunHairmvs("synthesize --output_path " + dir +
-                                    " --width 160 --num_strands 20000");
-  ASSERT_EQ(output.exit_code, 0) << output.text;
-  const std::string workspace = JoinPaths(dir, "dense");
+  const std::string workspace = SynthesizeSmallSet(dir);
+  CommandOutput output;
   const std::string run = "patch_match_stereo --workspace_path " + workspace +
                           " --workspace_format COLMAP --OrientationStereo.skip_existing 0";
   auto num_depths = [&](const std::string& type) {
