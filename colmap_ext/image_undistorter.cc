@@ -135,7 +135,9 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   RequireDir(input_path, "sparse model folder (--input_path)");
   THROW_IF(ExistsDir(JoinPaths(workspace_path, "sparse")),
            "Not creating the workspace " << workspace_path << ": it has a sparse/ model already");
-  fs::path target = fs::absolute(workspace_path).lexically_normal();
+  // Symlinks resolved: a workspace path that links to another file system is staged beside
+  // where its entries will live, so that they are renamed there, not across file systems.
+  fs::path target = fs::weakly_canonical(fs::absolute(workspace_path));
   if (!target.has_filename()) target = target.parent_path();  // "dense/"
   CreateDirs(target.parent_path().string());
   // Beside the workspace (the same file system, so that its entries are renamed, not copied),

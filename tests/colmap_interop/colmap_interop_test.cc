@@ -433,6 +433,18 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   EXPECT_EQ(FolderEntries(other), std::vector<std::string>{"images"});
   EXPECT_EQ(FolderEntries(JoinPaths(other, "images")), std::vector<std::string>{"mine.txt"});
   EXPECT_EQ(FolderEntries(out), (std::vector<std::string>{running, "dense", "other"}));
+  // A workspace path that is a link (to another disk, say) is staged beside the folder it
+  // links to, where its entries are renamed to.
+  const std::string elsewhere = JoinPaths(dir, "elsewhere");
+  CreateDirs(JoinPaths(elsewhere, "dense"));
+  const std::string link = JoinPaths(out, "linked");
+  std::filesystem::create_directory_symlink(JoinPaths(elsewhere, "dense"), link);
+  RunImageUndistorter(ColmapExecutable(), photos, sparse, link, [&](const std::string& staged) {
+    EXPECT_EQ(std::filesystem::path(staged).parent_path(),
+              std::filesystem::canonical(elsewhere));
+  });
+  EXPECT_EQ(Workspace::Read(link).ImageNames().size(), model.images.size());
+  EXPECT_EQ(FolderEntries(elsewhere), std::vector<std::string>{"dense"});
   std::filesystem::remove_all(dir);
 }
 
