@@ -539,8 +539,9 @@ std::vector<PatchMatchProblem> ReadPatchMatchConfig(const std::string& path,
     // As COLMAP's CSVToVector: tokens trimmed, empty ones skipped (`a.png, b.png,` is two
     // sources; a line of separators alone lists none, and the reference is dropped).
     std::vector<std::string> tokens;
-    for (const std::string& token : SplitString(line, ",;")) {
-      if (!StripWhitespace(token).empty()) tokens.push_back(StripWhitespace(token));
+    for (const std::string& part : SplitString(line, ",;")) {
+      std::string token = StripWhitespace(part);
+      if (!token.empty()) tokens.push_back(std::move(token));
     }
     if (tokens.empty()) {
       problem.kind = PatchMatchProblem::Kind::kExplicit;

@@ -180,8 +180,10 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   std::string options_error;
   if (!options.Check(&options_error) || !source_options.Check(&options_error)) {
     for (const MappedOption& option : mapped) {
+      // Check()'s messages begin with the field and a space ("max_image_size must be ..."):
+      // the space keeps geom_consistency from matching geom_consistency_min_views.
       if (parser.WasGiven(option.colmap_name) &&
-          options_error.find(option.field) != std::string::npos) {
+          options_error.find(std::string(option.field) + " ") != std::string::npos) {
         options_error += std::string(" (") + option.field + " is set by --" +
                          option.colmap_name + ")";
       }

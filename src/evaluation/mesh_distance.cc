@@ -58,21 +58,27 @@ std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double 
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::vector<Eigen::Vector3d> samples;
   const double cell = spacing_m * spacing_m;
+  std::vector<double> face_areas_m2;
+  face_areas_m2.reserve(mesh.faces.size());
   double area_m2 = 0;
   for (const Eigen::Vector3i& f : mesh.faces) {
-    const Eigen::Vector3f& a = mesh.vertices[f(0)];
-    area_m2 += 0.5 * (mesh.vertices[f(1)] - a).cross(mesh.vertices[f(2)] - a).norm();
+    const Eigen::Vector3d a = mesh.vertices[f(0)].cast<double>();
+    face_areas_m2.push_back(0.5 * (mesh.vertices[f(1)].cast<double>() - a)
+                                      .cross(mesh.vertices[f(2)].cast<double>() - a)
+                                      .norm());
+    area_m2 += face_areas_m2.back();
   }
   // Before a per-face count overflows int or the samples fill the memory.
   constexpr double kMaxSamples = 5e8;
   THROW_IF(area_m2 / cell > kMaxSamples,
            "Sampling " << area_m2 << " m^2 of mesh every " << spacing_m << " m would take "
                        << area_m2 / cell << " samples; use a larger sample spacing");
-  for (const Eigen::Vector3i& f : mesh.faces) {
+  for (size_t face = 0; face < mesh.faces.size(); ++face) {
+    const Eigen::Vector3i& f = mesh.faces[face];
     const Eigen::Vector3d a = mesh.vertices[f(0)].cast<double>();
     const Eigen::Vector3d b = mesh.vertices[f(1)].cast<double>();
     const Eigen::Vector3d c = mesh.vertices[f(2)].cast<double>();
-    const double expected = 0.5 * (b - a).cross(c - a).norm() / cell;
+    const double expected = face_areas_m2[face] / cell;
     int n = static_cast<int>(std::floor(expected));
     if (uniform(*rng) < expected - n) ++n;
     for (int i = 0; i < n; ++i) {
