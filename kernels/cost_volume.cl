@@ -12,10 +12,13 @@
 // homography of the plane the strand lies in (TransferDirection in
 // src/stereo/stereo_geometry.h): fronto-parallel, or, when has_gradient, tilted by
 // log_depth_gradient (2 planes: the gradient of log depth per pixel).
-// view_dims, per view (4 ints): width, height, offset of its planes in `source`, 0.
+// view_dims, per view (4 ints): width, height, offset of its planes in `source` (2 ints:
+// hm_plane_offset).
 // The reference orientation field is planar (Re plane, then Im plane); the source fields are
 // interleaved (Re, Im per pixel), since they are sampled at scattered points.
 // cost: [k][row][col] for k in [0, num_slices).
+
+#include "common.clh"
 
 inline float SampleDepth(float v, float depth_a, float depth_b, int inverse_depth) {
   const float t = depth_a + depth_b * v;
@@ -115,7 +118,7 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
       const float hz = m[6] * ct + m[7] * st + kappa * hpz;
       const int w = view_dims[4 * j];
       const int h = view_dims[4 * j + 1];
-      __global const float* src = source + view_dims[4 * j + 2];
+      __global const float* src = source + hm_plane_offset(view_dims + 4 * j);
       for (int i = 0; i < count; ++i) {
         const float ux = depth[i] * hpx + m[9];
         const float uy = depth[i] * hpy + m[10];

@@ -10,10 +10,12 @@
 // view_params, per view (20 floats): K_j A (9, row-major), the last row of A (3), K_j a (3),
 // a.z (1), K_ref C (3), 0.
 // view_dims, per view (4 ints): width and height of j's depth map, offset of the map in
-// depth_maps, 0. A point is seen when X_j.z > 0 and its projection (SfM convention: pixel
+// depth_maps (2 ints: hm_plane_offset). A point is seen when X_j.z > 0 and its projection (SfM convention: pixel
 // (c, r) covers [c, c+1) x [r, r+1)) falls inside the map; j's surface on the ray is
 // S = C + (X - C) * depth_j / X_j.z, projected back by K_ref.
 // ref_params (9 floats): K_ref^-1 (row-major).
+
+#include "common.clh"
 
 inline float3 MatVec(__global const float* m, float3 x) {
   return (float3)(m[0] * x.x + m[1] * x.y + m[2] * x.z, m[3] * x.x + m[4] * x.y + m[5] * x.z,
@@ -64,7 +66,7 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
     const float a_z = params[15];
     const float3 k_ref_c = (float3)(params[16], params[17], params[18]);
     const int map_width = view_dims[4 * j], map_height = view_dims[4 * j + 1];
-    __global const float* map = depth_maps + view_dims[4 * j + 2];
+    __global const float* map = depth_maps + hm_plane_offset(view_dims + 4 * j);
     for (int i = 0; i < count; ++i) {
       const float d = depth[i];
       float error = max_error_px;

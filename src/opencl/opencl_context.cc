@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <set>
@@ -320,6 +321,12 @@ cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes
   }
   return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
                     const_cast<void*>(data));
+}
+
+std::array<int, 4> ConcatenatedPlaneDims(int width, int height, size_t offset) {
+  const uint64_t offset64 = offset;
+  return {width, height, static_cast<int>(static_cast<uint32_t>(offset64 & 0xffffffffu)),
+          static_cast<int>(static_cast<uint32_t>(offset64 >> 32))};
 }
 
 }  // namespace hairmvs

@@ -21,6 +21,8 @@
 //  - Errors: OpenCL API failures surface as cl::Error (CL_HPP_ENABLE_EXCEPTIONS); a failed
 //    program build throws hairmvs::Error with the device's build log.
 
+#include <array>
+#include <cstddef>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -99,6 +101,12 @@ template <typename Container>
 cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const Container& host) {
   return ReadOnlyBuffer(context, host.data(), sizeof(*host.data()) * host.size());
 }
+
+// The four ints with which a kernel finds one of several planes concatenated into one buffer:
+// width, height, and the plane's offset in elements as its low and high 32 bits (read by
+// hm_plane_offset in kernels/common.clh). One int would wrap past 2^31 elements, e.g. at 45
+// source fields of 6000 x 4000 (2 floats a pixel) on a device that allocates that much.
+std::array<int, 4> ConcatenatedPlaneDims(int width, int height, size_t offset);
 
 // How many groups of `size` hold `count` items: e.g. the work-items of a kernel that takes
 // `size` pixels or depth slices each.

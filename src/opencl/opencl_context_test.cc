@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -44,6 +45,40 @@ TEST(OpenCLContext, BuildsAndRunsATrivialKernel) {
     const int j = std::min(i + 3, n - 1);
     ASSERT_EQ(out[i], 2.0f * in[j]) << "i=" << i;
   }
+}
+
+// The kernels find each of several concatenated planes at the offset the host packed, also past
+// 2^31 and 2^32 elements, which one int would wrap (no buffer that large is needed to check it).
+constexpr char kPlaneOffsetKernel[] = R"cl(
+#include "common.clh"
+__kernel void plane_offsets(__global const int* dims, __global ulong* out) {
+  const int j = get_global_id(0);
+  out[j] = (ulong)hm_plane_offset(dims + 4 * j);
+}
+)cl";
+
+TEST(OpenCLContext, ConcatenatedPlaneOffsetsPastTwoToThe31) {
+  auto context = OpenCLContext::Create();
+  const std::vector<size_t> offsets = {0, 123, (size_t{1} << 31) + 5, (size_t{1} << 32) + 7,
+                                       size_t{45} * 6000 * 4000 * 2};
+  std::vector<int> dims;
+  for (size_t k = 0; k < offsets.size(); ++k) {
+    const std::array<int, 4> plane = ConcatenatedPlaneDims(6000 + static_cast<int>(k), 4000,
+                                                           offsets[k]);
+    EXPECT_EQ(plane[0], 6000 + static_cast<int>(k));
+    EXPECT_EQ(plane[1], 4000);
+    dims.insert(dims.end(), plane.begin(), plane.end());
+  }
+  const cl::Buffer dims_buf = ReadOnlyBuffer(context.get(), dims);
+  cl::Buffer out_buf(context->Context(), CL_MEM_WRITE_ONLY, offsets.size() * sizeof(cl_ulong));
+  cl::Kernel kernel(context->ProgramFromSource(kPlaneOffsetKernel), "plane_offsets");
+  kernel.setArg(0, dims_buf);
+  kernel.setArg(1, out_buf);
+  context->Queue().enqueueNDRangeKernel(kernel, cl::NullRange, cl::NDRange(offsets.size()));
+  std::vector<cl_ulong> out(offsets.size());
+  context->Queue().enqueueReadBuffer(out_buf, CL_TRUE, 0, out.size() * sizeof(cl_ulong),
+                                     out.data());
+  for (size_t k = 0; k < offsets.size(); ++k) EXPECT_EQ(out[k], offsets[k]) << "plane " << k;
 }
 
 TEST(OpenCLContext, CachesPrograms) {

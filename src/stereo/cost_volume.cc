@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <complex>
 #include <string>
@@ -72,8 +73,9 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     const ViewProjection projection = ComputeViewProjection(ref.camera, src.camera, transfer);
     const auto packed = projection.Packed();
     params.insert(params.end(), packed.begin(), packed.end());
-    dims.insert(dims.end(), {src.field.Width(), src.field.Height(),
-                             static_cast<int>(all_sources.size()), 0});
+    const std::array<int, 4> plane =
+        ConcatenatedPlaneDims(src.field.Width(), src.field.Height(), all_sources.size());
+    dims.insert(dims.end(), plane.begin(), plane.end());
     if (cost == StereoCost::kOrientation) {  // interleaved, as orientation_cost samples it
       const float* re = src.field.Channel(0);
       const float* im = src.field.Channel(1);

@@ -28,8 +28,9 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
   std::vector<int> dims;
   for (const FusionView* view : prior.views) {
     cameras_.push_back({view->K, view->R, view->t});
-    dims.insert(dims.end(), {view->depth.Width(), view->depth.Height(),
-                             static_cast<int>(maps.size()), 0});
+    const std::array<int, 4> plane =
+        ConcatenatedPlaneDims(view->depth.Width(), view->depth.Height(), maps.size());
+    dims.insert(dims.end(), plane.begin(), plane.end());
     maps.insert(maps.end(), view->depth.Data().begin(), view->depth.Data().end());
   }
   depth_maps_ = ReadOnlyBuffer(context, maps);
