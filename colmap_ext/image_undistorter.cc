@@ -1,6 +1,7 @@
 #include "colmap_ext/image_undistorter.h"
 
 #include <signal.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -25,7 +26,7 @@ namespace fs = std::filesystem;
 namespace hairmvs {
 namespace {
 
-// Quotes a path for /bin/sh.
+// Quotes an argument for /bin/sh: the command printed can be pasted into a shell.
 std::string ShellQuote(const std::string& text) {
   std::string quoted = "'";
   for (char c : text) {
@@ -35,22 +36,75 @@ std::string ShellQuote(const std::string& text) {
   return quoted + "'";
 }
 
-// `colmap image_undistorter` with COLMAP's default options, the same for photos and masks.
-// Returns system()'s status (0: it exited with 0).
+// `colmap image_undistorter` with COLMAP's default options, the same for photos and masks, and
+// `extra_arguments` after them. Returns waitpid()'s status (0: it exited with 0; -1 with errno
+// if it could not be started).
+//
+// As system() would: this process ignores SIGINT and SIGQUIT while colmap runs, so a Ctrl-C at
+// the terminal (which reaches the whole process group) stops colmap alone and is reported by
+// its status. Unlike system(): colmap is started without a shell, and the kernel sends it
+// SIGTERM if this process ends first (PR_SET_PDEATHSIG), so that a SIGTERM or SIGHUP to hairmvs
+// alone (a scheduler's, or a closed terminal's) does not leave colmap writing into a scratch
+// folder that the next run removes.
 int Undistort(const std::string& colmap_executable, const std::string& image_path,
               const std::string& input_path, const std::string& output_path,
-              const std::string& extra_arguments) {
-  const std::string command = "QT_QPA_PLATFORM=offscreen " + ShellQuote(colmap_executable) +
-                              " image_undistorter --image_path " + ShellQuote(image_path) +
-                              " --input_path " + ShellQuote(input_path) + " --output_path " +
-                              ShellQuote(output_path) + " --output_type COLMAP" +
-                              extra_arguments;
+              const std::vector<std::string>& extra_arguments = {}) {
+  std::vector<std::string> arguments = {colmap_executable, "image_undistorter",
+                                        "--image_path",    image_path,
+                                        "--input_path",    input_path,
+                                        "--output_path",   output_path,
+                                        "--output_type",   "COLMAP"};
+  arguments.insert(arguments.end(), extra_arguments.begin(), extra_arguments.end());
+  std::string command = "QT_QPA_PLATFORM=offscreen";
+  for (const std::string& argument : arguments) command += " " + ShellQuote(argument);
   std::fprintf(stderr, "[image_undistorter] %s\n", command.c_str());
-  return std::system(command.c_str());
+  // Everything the child needs is allocated before fork(): after it, only async-signal-safe calls.
+  std::vector<char*> argv;
+  for (std::string& argument : arguments) argv.push_back(argument.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> environment = {"QT_QPA_PLATFORM=offscreen"};
+  for (char** entry = environ; *entry != nullptr; ++entry) {
+    if (std::strncmp(*entry, "QT_QPA_PLATFORM=", 16) != 0) environment.emplace_back(*entry);
+  }
+  std::vector<char*> envp;
+  for (std::string& entry : environment) envp.push_back(entry.data());
+  envp.push_back(nullptr);
+  static constexpr char kExecFailed[] = "hairmvs: could not run colmap\n";
+
+  struct sigaction ignore = {}, old_int = {}, old_quit = {};
+  ignore.sa_handler = SIG_IGN;
+  sigemptyset(&ignore.sa_mask);
+  sigaction(SIGINT, &ignore, &old_int);
+  sigaction(SIGQUIT, &ignore, &old_quit);
+  const pid_t parent = getpid();
+  const pid_t child = fork();
+  if (child == 0) {
+    sigaction(SIGINT, &old_int, nullptr);
+    sigaction(SIGQUIT, &old_quit, nullptr);
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    if (getppid() != parent) _exit(127);  // the parent ended before prctl
+    execvpe(argv[0], argv.data(), envp.data());
+    const ssize_t ignored = write(STDERR_FILENO, kExecFailed, sizeof(kExecFailed) - 1);
+    (void)ignored;
+    _exit(127);  // as a shell's "command not found"
+  }
+  int status = -1;
+  if (child > 0) {
+    while (waitpid(child, &status, 0) < 0) {
+      if (errno != EINTR) {
+        status = -1;
+        break;
+      }
+    }
+  }
+  const int saved_errno = errno;
+  sigaction(SIGINT, &old_int, nullptr);
+  sigaction(SIGQUIT, &old_quit, nullptr);
+  errno = saved_errno;
+  return status;
 }
 
-// How a command that system() ran ended, for an error message. While it runs, system() has this
-// process ignore SIGINT, so a Ctrl-C stops colmap alone and is reported here.
+// How a command that Undistort ran ended, for an error message.
 std::string DescribeStatus(int status) {
   if (status == -1) return std::string("could not be started: ") + std::strerror(errno);
   if (WIFEXITED(status)) return "exit status " + std::to_string(WEXITSTATUS(status));
@@ -144,7 +198,7 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   // hidden, and removed if anything fails or colmap is stopped.
   const ScratchDir staging(target.parent_path(),
                            "." + target.filename().string() + ".undistorting");
-  const int status = Undistort(colmap_executable, image_path, input_path, staging.Path(), "");
+  const int status = Undistort(colmap_executable, image_path, input_path, staging.Path());
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
                             << " for --image_path " << image_path << " --input_path "
                             << input_path << "; is COLMAP installed (apt-get install colmap)? "
@@ -202,8 +256,8 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   }
   const std::string undistorted = JoinPaths(scratch.Path(), "undistorted");
   const int status = Undistort(colmap_executable, binarised, input_path, undistorted,
-                               " --image_list_path " + ShellQuote(list_path) +
-                                   " --max_image_size " + std::to_string(max_image_size));
+                               {"--image_list_path", list_path, "--max_image_size",
+                                std::to_string(max_image_size)});
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
                                                     << " on the masks of " << mask_path
                                                     << " with --input_path " << input_path);

@@ -350,8 +350,8 @@ std::string WriteFailingColmap(const std::string& dir, const std::string& name,
   return path;
 }
 
-// A workspace made from photos appears only once whole: colmap failing, stopped by Ctrl-C (its
-// shell killed by SIGINT), or the masks failing after it leave neither the workspace nor the
+// A workspace made from photos appears only once whole: colmap failing, stopped by Ctrl-C (it
+// and this process sent SIGINT, as a terminal sends it), or the masks failing after it leave neither the workspace nor the
 // hidden folder it was made in; a whole one is published with everything the undistorter and
 // the step before publishing wrote, and removes what a run a signal ended left.
 TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
@@ -445,6 +445,52 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   });
   EXPECT_EQ(Workspace::Read(link).ImageNames().size(), model.images.size());
   EXPECT_EQ(FolderEntries(elsewhere), std::vector<std::string>{"dense"});
+  std::filesystem::remove_all(dir);
+}
+
+// Whether process `pid` exists and is not a zombie (one that no parent reaps counts as ended).
+bool ProcessRuns(pid_t pid) {
+  std::ifstream stat("/proc/" + std::to_string(pid) + "/stat");
+  std::string line;
+  if (!std::getline(stat, line)) return false;
+  const size_t name_end = line.rfind(')');
+  return name_end != std::string::npos && name_end + 2 < line.size() && line[name_end + 2] != 'Z';
+}
+
+// A SIGTERM to hairmvs alone (a scheduler's, not a terminal's Ctrl-C to the whole group) ends
+// the colmap it started too, rather than leaving it writing into the hidden folder that the
+// next run removes.
+TEST(ColmapInterop, ColmapEndsWithTheRunThatStartedIt) {
+  const std::string dir = MakeTestDir("interop_sigterm");
+  const std::string photos = JoinPaths(dir, "photos"), sparse = JoinPaths(dir, "sparse");
+  CreateDirs(photos);
+  CreateDirs(sparse);
+  WriteReconstruction(MakePlaneModel(), sparse, ModelFormat::kText);
+  const std::string pid_file = JoinPaths(dir, "colmap.pid");
+  const std::string colmap = WriteFailingColmap(
+      dir, "lingers", "echo $$ > " + pid_file + ".tmp && mv " + pid_file + ".tmp " + pid_file +
+                          " && exec sleep 120");
+  const pid_t run = fork();
+  ASSERT_GE(run, 0);
+  if (run == 0) {
+    try {
+      RunImageUndistorter(colmap, photos, sparse, JoinPaths(dir, "dense"));
+    } catch (...) {
+    }
+    _exit(0);
+  }
+  // Bounded waits for the processes to get where the test needs them, not timings.
+  for (int i = 0; i < 600 && !ExistsFile(pid_file); ++i) usleep(100000);
+  ASSERT_TRUE(ExistsFile(pid_file));
+  const pid_t colmap_pid = std::stoi(ReadTextFile(pid_file));
+  EXPECT_TRUE(ProcessRuns(colmap_pid));
+  ASSERT_EQ(kill(run, SIGTERM), 0);
+  int status = 0;
+  ASSERT_EQ(waitpid(run, &status, 0), run);
+  EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+  for (int i = 0; i < 200 && ProcessRuns(colmap_pid); ++i) usleep(50000);
+  EXPECT_FALSE(ProcessRuns(colmap_pid)) << "colmap (" << colmap_pid << ") outlived its run";
+  if (ProcessRuns(colmap_pid)) kill(colmap_pid, SIGKILL);
   std::filesystem::remove_all(dir);
 }
 
