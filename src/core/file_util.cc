@@ -35,10 +35,12 @@ bool ExistsDir(const std::string& path) {
 }
 
 void RequireFile(const std::string& path, const std::string& what) {
+  THROW_IF(ExistsDir(path), "The " << what << " " << path << " is a folder, not a file");
   THROW_IF(!ExistsFile(path), "Missing " << what << ": " << path);
 }
 
 void RequireDir(const std::string& path, const std::string& what) {
+  THROW_IF(ExistsFile(path), "The " << what << " " << path << " is a file, not a folder");
   THROW_IF(!ExistsDir(path), "Missing " << what << ": " << path);
 }
 
@@ -251,6 +253,10 @@ void RemoveTemporaryFilesOnInterrupt() {
     action.sa_flags = SA_RESETHAND;
     sigaction(signal_number, &action, nullptr);
   }
+  // A file past the size limit (ulimit -f) would otherwise end the process by SIGXFSZ with no
+  // message and its temporary left; ignored, the write fails with EFBIG, which the writer
+  // reports ("File too large") and cleans up after, as for a full disk.
+  signal(SIGXFSZ, SIG_IGN);
 }
 
 }  // namespace hairmvs

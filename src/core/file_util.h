@@ -63,8 +63,9 @@ void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>&
 // Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
 // temporary files of the writes above still in flight, then let the signal end the process as
 // it would have: a run stopped with Ctrl-C or by a cluster scheduler leaves no hidden
-// temporaries in the workspace, and every target is either its old or its new file.
-// The hairmvs binary calls it first thing.
+// temporaries in the workspace, and every target is either its old or its new file. Also
+// ignores SIGXFSZ, so that a file past `ulimit -f` fails its write with a message, as a full
+// disk does, rather than ending the process. The hairmvs binary calls it first thing.
 void RemoveTemporaryFilesOnInterrupt();
 
 }  // namespace hairmvs

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
@@ -76,6 +78,31 @@ TEST(FileUtil, InterruptHandlersLeaveIgnoredSignalsIgnored) {
         std::_Exit(0);
       },
       ::testing::ExitedWithCode(0), "");
+}
+
+// Past `ulimit -f` a write fails with a message and leaves the old file, rather than SIGXFSZ
+// ending the process with its temporary left.
+TEST(FileUtil, FileSizeLimitFailsTheWriteNotTheProcess) {
+  const std::string dir = TestDir("size_limit");
+  const std::string kept = JoinPaths(dir, "kept.txt");
+  WriteFileAtomically(kept, [](std::ostream& out) { out << "old"; });
+  EXPECT_EXIT(
+      {
+        RemoveTemporaryFilesOnInterrupt();
+        rlimit limit{};
+        getrlimit(RLIMIT_FSIZE, &limit);
+        limit.rlim_cur = 1000;
+        setrlimit(RLIMIT_FSIZE, &limit);
+        const std::string message = testing_util::ErrorOf([&] {
+          WriteFileAtomically(kept, [](std::ostream& out) { out << std::string(5000, 'x'); });
+        });
+        std::_Exit(message.find("File too large") != std::string::npos &&
+                           testing_util::NumEntriesIn(dir) == 1
+                       ? 0
+                       : 5);
+      },
+      ::testing::ExitedWithCode(0), "");
+  EXPECT_EQ(ReadTextFile(kept), "old");
 }
 
 // Files written as a unit: a writer that throws after another's temporary is complete leaves
@@ -182,6 +209,17 @@ TEST(FileUtil, MissingFileErrorNamesThePath) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/hairmvs/cameras.bin"), std::string::npos);
     EXPECT_NE(std::string(e.what()).find("camera file"), std::string::npos);
   }
+}
+
+// A folder where a file is expected, or the other way round, is named as such, not as missing.
+TEST(FileUtil, FileWhereAFolderIsExpectedIsNamed) {
+  const std::string dir = TestDir("kinds");
+  const std::string file = JoinPaths(dir, "fused.ply");
+  WriteFileAtomically(file, [](std::ostream& out) { out << "ply"; });
+  EXPECT_EQ(testing_util::ErrorOf([&] { RequireDir(file, "workspace folder"); }),
+            "The workspace folder " + file + " is a file, not a folder");
+  EXPECT_EQ(testing_util::ErrorOf([&] { RequireFile(dir, "camera file"); }),
+            "The camera file " + dir + " is a folder, not a file");
 }
 
 TEST(FileUtil, SplitAndStrip) {

@@ -314,6 +314,13 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
     }
     THROW_IF(read != static_cast<zip_int64_t>(bytes.size()),
              source << ": truncated entry (" << read << " of " << bytes.size() << " bytes)");
+    // libzip checks the entry's CRC once a read reaches its end, not on the last byte asked for:
+    // without this read, a corrupt deflate stream of the right length would be taken as data.
+    char past_end = 0;
+    const zip_int64_t at_end = zip_fread(file, &past_end, 1);
+    THROW_IF(at_end != 0, source << ": corrupt entry: "
+                                 << (at_end < 0 ? zip_file_strerror(file)
+                                                : "longer than its stated size"));
     name.resize(name.size() - 4);
     arrays[name] = ParseNpy(bytes.data(), bytes.size(), source);
   }

@@ -150,6 +150,20 @@ TEST(Npz, ErrorsNameTheFile) {
   EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(bad_npy); }).find("bad_npy.npz:a.npy"),
             std::string::npos);
 
+  // An entry whose bytes no longer match its CRC (a flipped bit in the payload, the length
+  // unchanged): an error, not other depths.
+  const std::string npy_bytes = FormatNpy(NpyArray::FromVector(std::vector<float>(256, 0.5f)));
+  const std::string crc_path = JoinPaths(dir, "crc.npz");
+  WriteStoredZip(crc_path, "a.npy", npy_bytes);
+  std::string zipped = ReadTextFile(crc_path);
+  const size_t payload = zipped.find(npy_bytes);
+  ASSERT_NE(payload, std::string::npos);
+  zipped[payload + npy_bytes.size() - 1] ^= 0x10;
+  WriteBytes(crc_path, zipped);
+  const std::string crc_message = ExpectThrowMessage([&] { ReadNpz(crc_path); });
+  EXPECT_NE(crc_message.find("crc.npz:a.npy: corrupt entry: CRC error"), std::string::npos)
+      << crc_message;
+
   // Fortran order.
   std::string fortran = FormatNpy(NpyArray::FromVector<float>({1, 2, 3, 4}, {2, 2}));
   fortran.replace(fortran.find("False"), 5, "True ");
