@@ -607,10 +607,7 @@ void WritePatchMatchConfig(const std::string& path,
             case PatchMatchProblem::Kind::kAuto: out << "__auto__, " << p.num_auto << "\n"; break;
             case PatchMatchProblem::Kind::kExplicit:
               CHECK(!p.sources.empty()) << p.reference;
-              for (size_t k = 0; k < p.sources.size(); ++k) {
-                out << (k ? ", " : "") << p.sources[k];
-              }
-              out << "\n";
+              out << JoinStrings(p.sources, ", ") << "\n";
               break;
           }
         }

@@ -297,9 +297,7 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     // rescales masks too). Another aspect ratio cannot line up with the image, e.g. a mask
     // drawn on a photo before colmap image_undistorter changed its size: an error, not a
     // silently shifted mask. One pixel of rounding is allowed each way.
-    const double height_at_width = static_cast<double>(keep.rows) * width / keep.cols;
-    const double width_at_height = static_cast<double>(keep.cols) * height / keep.rows;
-    THROW_IF(std::abs(height_at_width - height) > 1 && std::abs(width_at_height - width) > 1,
+    THROW_IF(!IsScaledCopy(keep.cols, keep.rows, width, height),
              "Mask " << path << " is " << keep.cols << " x " << keep.rows
                      << ", another aspect ratio than its image's (read at " << width << " x "
                      << height << "): a mask is drawn on its own image (the workspace's "

@@ -28,6 +28,25 @@ StereoCamera StereoCamera::Scaled(int new_width, int new_height) const {
   return scaled;
 }
 
+bool IsScaledCopy(int w, int h, int width, int height) {
+  if (w == width && h == height) return true;
+  if (w <= 0 || h <= 0 || width <= 0 || height <= 0) return false;
+  // Whether b's size is a's scaled, to a pixel in b's units (one side rounded either way).
+  auto fits = [](double a_w, double a_h, double b_w, double b_h) {
+    return std::abs(a_h * b_w / a_w - b_h) <= 1 || std::abs(a_w * b_h / a_h - b_w) <= 1;
+  };
+  return fits(w, h, width, height) || fits(width, height, w, h);
+}
+
+StereoCamera StereoCamera::ScaledToMap(int map_width, int map_height,
+                                       const std::string& map_path) const {
+  THROW_IF(!IsScaledCopy(map_width, map_height, width, height),
+           map_path << " is " << map_width << " x " << map_height
+                    << ", another aspect ratio than its image's " << width << " x " << height
+                    << ": a map of another view, or of another model");
+  return Scaled(map_width, map_height);
+}
+
 StereoCamera StereoCamera::AtMaxImageSize(int max_image_size) const {
   if (max_image_size <= 0 || std::max(width, height) <= max_image_size) return *this;
   const double scale = static_cast<double>(max_image_size) / std::max(width, height);

@@ -4,6 +4,7 @@
 // code uses (col, row), half a pixel off).
 
 #include <Eigen/Core>
+#include <string>
 
 #include "src/core/float_map.h"
 
@@ -26,6 +27,10 @@ bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Ei
                     int width, int height, const Eigen::Vector3d& world, int* col, int* row,
                     double* depth);
 
+// Whether a w x h picture is one of width x height at another scale, to a pixel's rounding each
+// way: a depth map or mask that a max_image_size made smaller, not one of another aspect ratio.
+bool IsScaledCopy(int w, int h, int width, int height);
+
 // A pinhole camera on a width x height pixel grid: X_cam = R X_world + t. The stereo's cameras
 // at the processing resolution and its pyramid levels, the evaluators' workspace and true
 // cameras (ViewCamera in colmap_ext/workspace.h builds a view's).
@@ -39,6 +44,10 @@ struct StereoCamera {
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // The same camera for an image of width x height covering the same extent (a resized image).
   StereoCamera Scaled(int new_width, int new_height) const;
+  // Scaled to a map of map_width x map_height read from `map_path` (COLMAP writes smaller maps
+  // with --PatchMatchStereo.max_image_size); throws naming the file when the map is not the
+  // image at another scale (IsScaledCopy), e.g. a map of another view or model.
+  StereoCamera ScaledToMap(int map_width, int map_height, const std::string& map_path) const;
   // Scaled to COLMAP's max_image_size rule: the longer side at most `max_image_size` (scale,
   // round); itself when max_image_size <= 0 or the image is no larger.
   StereoCamera AtMaxImageSize(int max_image_size) const;

@@ -6,6 +6,8 @@
 #include <Eigen/Geometry>
 #include <utility>
 
+#include "src/core/test_util.h"
+
 namespace hairmvs {
 namespace {
 
@@ -43,6 +45,24 @@ TEST(DepthGeometry, AtMaxImageSizeFollowsColmapsRule) {
     EXPECT_EQ(same.height, 640) << unchanged;
     EXPECT_EQ(same.K, camera.K) << unchanged;
   }
+}
+
+// A map at another scale (COLMAP's max_image_size) fits its image to a pixel's rounding each
+// way; one of another aspect ratio does not, and is named.
+TEST(DepthGeometry, MapsAtAnotherScaleFitTheirCamera) {
+  EXPECT_TRUE(IsScaledCopy(960, 640, 960, 640));
+  EXPECT_TRUE(IsScaledCopy(320, 213, 960, 640));
+  EXPECT_TRUE(IsScaledCopy(320, 214, 960, 640));
+  EXPECT_FALSE(IsScaledCopy(320, 216, 960, 640));
+  EXPECT_FALSE(IsScaledCopy(640, 960, 960, 640));
+  EXPECT_FALSE(IsScaledCopy(0, 640, 960, 640));
+  StereoCamera camera;
+  camera.width = 960;
+  camera.height = 640;
+  EXPECT_EQ(camera.ScaledToMap(480, 320, "m.bin").K(0, 0), 0.5);
+  EXPECT_EQ(testing_util::ErrorOf([&] { camera.ScaledToMap(640, 960, "m.bin"); }),
+            "m.bin is 640 x 960, another aspect ratio than its image's 960 x 640: a map of "
+            "another view, or of another model");
 }
 
 // A camera's pixel round-trips through the world and back, on its own grid and on a scaled

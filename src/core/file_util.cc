@@ -98,6 +98,12 @@ std::vector<std::string> SplitString(const std::string& s, const std::string& de
   return parts;
 }
 
+std::string JoinStrings(const std::vector<std::string>& parts, const std::string& separator) {
+  std::string joined;
+  for (size_t i = 0; i < parts.size(); ++i) joined += (i ? separator : "") + parts[i];
+  return joined;
+}
+
 namespace {
 
 // The temporary files of the atomic writes in flight, for the interrupt handler. Slots are

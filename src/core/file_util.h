@@ -32,6 +32,8 @@ std::string ReadTextFile(const std::string& path);
 std::vector<std::string> ReadLines(const std::string& path);
 std::string StripWhitespace(const std::string& s);
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims);
+// The parts with `separator` between them: "a, b" from {"a", "b"} and ", ".
+std::string JoinStrings(const std::vector<std::string>& parts, const std::string& separator);
 
 // Writes `path` atomically: `write` fills a stream for a temporary file next to `path`,
 // which is then renamed to `path`. Parent folders are created. If `write` throws, the

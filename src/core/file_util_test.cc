@@ -228,6 +228,9 @@ TEST(FileUtil, SplitAndStrip) {
   ASSERT_EQ(parts.size(), 3u);
   EXPECT_EQ(StripWhitespace(parts[1]), "b");
   EXPECT_EQ(parts[2], "c");
+  EXPECT_EQ(JoinStrings({"a", "b", "c"}, ", "), "a, b, c");
+  EXPECT_EQ(JoinStrings({"a"}, ", "), "a");
+  EXPECT_EQ(JoinStrings({}, ", "), "");
 }
 
 }  // namespace

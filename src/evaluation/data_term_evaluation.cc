@@ -207,9 +207,11 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
     const StereoCamera truth_camera =
         options.in_true_cameras
             ? TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
-            : view_camera.Scaled(gt_width, gt_height);
+            : view_camera.ScaledToMap(gt_width, gt_height,
+                                      GroundTruthViewPath(ground_truth_path, name));
     EvaluateView(volume, gt, truth_camera,
-                 view_camera.Scaled(volume.cost.Width(), volume.cost.Height()),
+                 view_camera.ScaledToMap(volume.cost.Width(), volume.cost.Height(),
+                                         ws.CostVolumePath(name)),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);

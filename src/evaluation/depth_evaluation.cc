@@ -235,7 +235,8 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
     const int width = depth.Width(), height = depth.Height();
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
-    const StereoCamera camera = ws.ViewCamera(name).Scaled(width, height);
+    const StereoCamera camera =
+        ws.ViewCamera(name).ScaledToMap(width, height, ws.DepthMapPath(name, options.depth_type));
     std::optional<StereoCamera> true_camera;
     if (options.in_true_cameras) {
       true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);

@@ -189,12 +189,16 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
     const Workspace workspace = Workspace::Read(workspace_path);
     const std::vector<std::string>& names = workspace.ImageNames();
     Progress progress("template_fusion read", static_cast<int>(names.size()));
+    std::vector<std::string> photometric_only;  // --input_type auto took their first estimate
     for (size_t idx = 0; idx < names.size(); ++idx) {
       const std::string& name = names[idx];
       progress.Start(static_cast<int>(idx), name);
       std::string type = options.input_type;
       if (type == "auto") {
         type = ExistsFile(workspace.DepthMapPath(name, "geometric")) ? "geometric" : "photometric";
+        if (type == "photometric" && ExistsFile(workspace.DepthMapPath(name, type))) {
+          photometric_only.push_back(name);
+        }
       }
       const std::string depth_path = workspace.DepthMapPath(name, type);
       if (!ExistsFile(depth_path)) {
@@ -207,8 +211,8 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       THROW_IF(view.depth.Channels() != 1, depth_path << ": a depth map needs 1 channel, not "
                                                       << view.depth.Channels());
       // COLMAP writes smaller depth maps with --PatchMatchStereo.max_image_size.
-      const StereoCamera camera =
-          workspace.ViewCamera(name).Scaled(view.depth.Width(), view.depth.Height());
+      const StereoCamera camera = workspace.ViewCamera(name).ScaledToMap(
+          view.depth.Width(), view.depth.Height(), depth_path);
       view.K = camera.K;
       view.R = camera.R;
       view.t = camera.t;
@@ -230,6 +234,14 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       image_idx_of_view.push_back(static_cast<uint32_t>(idx));
     }
     progress.Finish();
+    // Mixed maps are worth a word: a view whose geometric pass did not run (or failed) brings
+    // depths that no source view confirmed. All first estimates (a single-pass stereo) are not.
+    if (!photometric_only.empty() && photometric_only.size() < views.size()) {
+      LOG(WARNING) << photometric_only.size() << " of " << views.size()
+                   << " views have no .geometric depth map: fused from their .photometric one "
+                      "(the first estimate, unfiltered by the source views' agreement): "
+                   << JoinStrings(photometric_only, ", ");
+    }
     THROW_IF(views.empty(), workspace.StereoPath()
                                 << ": no depth map (stereo/depth_maps/<image>.<type>.bin) to fuse");
   }

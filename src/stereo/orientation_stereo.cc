@@ -682,7 +682,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           view.depth = ReadMat(path);
           THROW_IF(view.depth.Channels() != 1,
                    path << ": not a depth map (" << view.depth.Channels() << " channels)");
-          view.K = camera.Scaled(view.depth.Width(), view.depth.Height()).K;
+          view.K = camera.ScaledToMap(view.depth.Width(), view.depth.Height(), path).K;
           view.R = camera.R;
           view.t = camera.t;
         }

@@ -15,6 +15,8 @@
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
 #include "colmap_ext/reconstruction.h"
+#include "colmap_ext/test_util.h"
+#include "colmap_ext/workspace.h"
 #include "hairmvs/template_fusion.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
@@ -208,6 +210,41 @@ TEST(FusionWorkspace, NoDepthMapsIsAnErrorNamingTheFolder) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("stereo"), std::string::npos) << e.what();
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A depth map of another aspect ratio than its image (another view's or model's) is an error
+// naming it, not a camera stretched one way; views without a .geometric map among views with
+// one are fused from their first estimate, and the log names them.
+TEST(FusionWorkspace, DepthMapsThatDoNotFitTheirViewAreNamed) {
+  const std::string dir = MakeTempDir("misfit");
+  WriteWorkspace(testing::RenderViews(testing::TorusSdf(1.0, 0.4), TorusViews()), dir);
+  const Workspace workspace = Workspace::Read(dir);
+  const std::string first = workspace.ImageNames()[0], second = workspace.ImageNames()[1];
+  const std::string depth_path = workspace.DepthMapPath(first, "geometric");
+  const FloatMap depth = ReadMat(depth_path);
+  const std::string size = std::to_string(depth.Width()) + " x " + std::to_string(depth.Height());
+  const std::string transposed =
+      std::to_string(depth.Height()) + " x " + std::to_string(depth.Width());
+  WriteMat(depth_path, FloatMap(depth.Height(), depth.Width(), 1, 1.0f));
+  std::filesystem::remove(workspace.NormalMapPath(first, "geometric"));
+  const std::string error =
+      testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), nullptr); });
+  EXPECT_EQ(error, depth_path + " is " + transposed + ", another aspect ratio than its image's " +
+                       size + ": a map of another view, or of another model");
+  WriteMat(depth_path, depth);
+  for (const std::string kind : {"depth_maps", "normal_maps"}) {
+    std::filesystem::rename(JoinPaths(dir, "stereo", kind, second + ".geometric.bin"),
+                            JoinPaths(dir, "stereo", kind, second + ".photometric.bin"));
+  }
+  ::testing::internal::CaptureStderr();
+  RunTemplateFusion(dir, EveryPixelOneThread(), nullptr);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("1 of " + std::to_string(workspace.ImageNames().size()) +
+                     " views have no .geometric depth map: fused from their .photometric one"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("agreement): " + second + "\n"), std::string::npos) << log;
   std::filesystem::remove_all(dir);
 }
 
