@@ -382,10 +382,26 @@ class ViewLoader {
 };
 
 // Whether the `type` (geometric or photometric) depth and normal maps of `name` exist.
+// Whether `name`'s `type` depth and normal maps are there as whole Mats of 1 and 3 channels of
+// one size, as skip_existing needs. A damaged one (cut short, another format: the writes are
+// atomic, so not ours) counts as missing, with a warning, and is computed again.
 bool HasDepthAndNormals(const Workspace& workspace, const std::string& name,
                         const std::string& type) {
-  return ExistsFile(workspace.DepthMapPath(name, type)) &&
-         ExistsFile(workspace.NormalMapPath(name, type));
+  const std::string depth_path = workspace.DepthMapPath(name, type);
+  const std::string normal_path = workspace.NormalMapPath(name, type);
+  if (!ExistsFile(depth_path) || !ExistsFile(normal_path)) return false;
+  try {
+    const MatShape depth = ReadMatShape(depth_path);
+    const MatShape normal = ReadMatShape(normal_path);
+    THROW_IF(depth.channels != 1,
+             depth_path << ": a depth map has 1 channel, not " << depth.channels);
+    THROW_IF(normal.channels != 3 || normal.width != depth.width || normal.height != depth.height,
+             normal_path << ": a normal map has 3 channels and its depth map's size");
+  } catch (const Error& e) {
+    LOG(WARNING) << e.what() << ": " << name << " is computed again";
+    return false;
+  }
+  return true;
 }
 
 // Writes a depth map, its normal map and, with `png`, their pictures, as `type` (geometric or
@@ -445,6 +461,19 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   for (const SourceViewSelection& selection : SelectSourceViews(workspace, source_options)) {
     sources_of[selection.reference] = selection.sources;
   }
+  // A whole-workspace run that could write no map at all is an error, not "0 depth maps" and
+  // rc 0. A subset's view without sources only warns: a job of a cluster array may get one.
+  THROW_IF(image_names.empty() && std::none_of(names.begin(), names.end(),
+                                               [&](const std::string& name) {
+                                                 return sources_of.count(name) > 0 &&
+                                                        !sources_of.at(name).empty();
+                                               }),
+           "No view of " << workspace_path << " has source views to match against ("
+                         << (source_options.use_config
+                                 ? "stereo/patch-match.cfg, where it exists, lists none; "
+                                 : "")
+                         << "no two views share sparse points of sparse/): no depth map can "
+                            "be computed");
 
   std::shared_ptr<OpenCLContext> context = OpenCLContext::Create(device_spec);
   const OrientationFieldOptions fields =

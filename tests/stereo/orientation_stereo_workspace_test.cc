@@ -375,11 +375,19 @@ TEST(OrientationStereoWorkspace, SkipExistingResumesWhereARunStopped) {
   for (const char* type : {"photometric", "geometric"}) {
     std::filesystem::remove(workspace.DepthMapPath("v2.png", type));
   }
+  // v3's map cut short (not by us: the writes are atomic) is not taken for a whole one.
+  const std::string v3_geometric = workspace.DepthMapPath("v3.png", "geometric");
+  std::filesystem::resize_file(v3_geometric, 3000);
   options.skip_existing = true;
+  ::testing::internal::CaptureStderr();
   const OrientationStereoResult result = RunOrientationStereo(path, {}, options, &timings);
-  EXPECT_EQ(result.num_skipped, 2);
-  EXPECT_EQ(result.num_resumed_at_geometric_pass, 1);
-  EXPECT_EQ(result.num_views, 2);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find(v3_geometric), std::string::npos) << log;
+  EXPECT_NE(log.find("v3.png is computed again"), std::string::npos) << log;
+  EXPECT_EQ(result.num_skipped, 1);
+  EXPECT_EQ(result.num_resumed_at_geometric_pass, 2);
+  EXPECT_EQ(result.num_views, 3);
+  EXPECT_EQ(ReadMat(v3_geometric).Width(), 96);
   EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), marker.Data());
   EXPECT_EQ(ReadMat(workspace.DepthMapPath("v1.png", "photometric")).Data(), marker.Data());
   EXPECT_TRUE(ExistsFile(workspace.DepthMapPath("v1.png", "geometric")));
@@ -664,6 +672,23 @@ TEST(OrientationStereoWorkspace, ViewsThatAreNoReferenceAreSourcesOnly) {
   EXPECT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 3);
   EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), geometric.Data());
   EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v3.png", "geometric")));
+  std::filesystem::remove_all(path);
+}
+
+// A run over the whole workspace that could write no map (an empty patch-match.cfg) is an
+// error; a subset whose views have no sources (a cluster job's) is warned about.
+TEST(OrientationStereoWorkspace, NoViewWithSourcesIsAnError) {
+  const std::string path = MakeTestDir("stereo_no_sources");
+  WriteWorkspace(path);
+  std::ofstream(JoinPaths(path, "stereo", "patch-match.cfg")).close();
+  const std::string error =
+      ErrorOf([&] { RunOrientationStereo(path, {}, PlaneOptions(), nullptr); });
+  EXPECT_NE(error.find("No view of " + path + " has source views to match against "
+                       "(stereo/patch-match.cfg, where it exists, lists none; no two views "
+                       "share sparse points of sparse/)"),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, PlaneOptions(), nullptr).num_views, 0);
   std::filesystem::remove_all(path);
 }
 
