@@ -81,12 +81,21 @@ bool CheckImageNames(const std::vector<std::string>& names, std::string* error) 
 std::vector<std::string> ViewsToEvaluate(
     const Workspace& ws, const std::vector<std::string>& requested,
     const std::function<std::string(const std::string&)>& path_of, const std::string& none_found) {
-  if (!requested.empty()) return requested;
-  std::vector<std::string> names;
+  if (!requested.empty()) {
+    for (const std::string& name : requested) ws.ImageIdx(name);  // throws for unknown names
+    return requested;
+  }
+  std::vector<std::string> names, missing;
   for (const std::string& name : ws.ImageNames()) {
-    if (ExistsFile(path_of(name))) names.push_back(name);
+    (ExistsFile(path_of(name)) ? names : missing).push_back(name);
   }
   THROW_IF(names.empty(), none_found);
+  // The overall figures are over the views evaluated: a view left out must be seen.
+  if (!missing.empty()) {
+    LOG(WARNING) << missing.size() << " of " << ws.ImageNames().size()
+                 << " views are not evaluated, for want of their file (e.g. "
+                 << path_of(missing.front()) << "): " << JoinStrings(missing, ", ");
+  }
   return names;
 }
 

@@ -29,8 +29,9 @@ double Mean(const std::vector<double>& values);
 // scipy.ndimage.median_filter(depth, k) up to its border rule.
 FloatMap MedianFilterValidDepths(const FloatMap& depth, int k, bool include_invalid = false);
 
-// The views a workspace evaluator reads: `requested` when given, else every image of the
-// workspace whose `path_of(name)` exists. Throws hairmvs::Error with `none_found` when none does.
+// The views a workspace evaluator reads: `requested` when given (each must be an image of the
+// workspace), else every image of the workspace whose `path_of(name)` exists, with a warning
+// naming those left out. Throws hairmvs::Error with `none_found` when none does.
 std::vector<std::string> ViewsToEvaluate(
     const Workspace& ws, const std::vector<std::string>& requested,
     const std::function<std::string(const std::string&)>& path_of, const std::string& none_found);

@@ -147,6 +147,21 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
   EXPECT_EQ(json["views"].size(), 2u);
   EXPECT_EQ(json["overall"]["num_hair_pixels"].get<long>(), result.overall.num_hair_pixels);
   EXPECT_NE(result.Table().find("overall"), std::string::npos);
+
+  // A view without its map is named as left out of the overall figures; a view asked for that
+  // the workspace lacks is an error, not a missing file.
+  std::filesystem::remove(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"));
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(EvaluateDepthMaps(out, scene.gt, FastDepthOptions()).views.size(), 1u);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("1 of 2 views are not evaluated, for want of their file (e.g. " +
+                     JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin") + "): v1.png"),
+            std::string::npos)
+      << log;
+  DepthEvaluationOptions unknown = FastDepthOptions();
+  unknown.image_names = {"v9.png"};
+  EXPECT_EQ(testing_util::ErrorOf([&] { EvaluateDepthMaps(out, scene.gt, unknown); }),
+            "Image with name `v9.png` does not exist in workspace " + out);
 }
 
 TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
