@@ -36,6 +36,30 @@ std::string ShellQuote(const std::string& text) {
   return quoted + "'";
 }
 
+// Throws naming `executable` (a path, or a name looked up in PATH as execvp would) unless it is
+// a file this process may execute: said before colmap is started, not as its exit status 127.
+void RequireExecutable(const std::string& executable) {
+  std::vector<std::string> candidates;
+  if (executable.find('/') != std::string::npos) {
+    candidates.push_back(executable);
+  } else {
+    const char* path = std::getenv("PATH");
+    for (const std::string& dir : SplitString(path != nullptr ? path : "", ":")) {
+      candidates.push_back(JoinPaths(dir.empty() ? "." : dir, executable));
+    }
+  }
+  for (const std::string& candidate : candidates) {
+    if (ExistsFile(candidate) && access(candidate.c_str(), X_OK) == 0) return;
+  }
+  HAIRMVS_THROW("Cannot run " << executable << ": "
+                              << (executable.find('/') != std::string::npos
+                                      ? (ExistsFile(executable) ? "not executable"
+                                                                : "no such file")
+                                      : "not found in PATH")
+                              << "; install COLMAP (apt-get install colmap), or give its path "
+                                 "with --colmap_executable");
+}
+
 // `colmap image_undistorter` with COLMAP's default options, the same for photos and masks, and
 // `extra_arguments` after them. Returns waitpid()'s status (0: it exited with 0; -1 with errno
 // if it could not be started).
@@ -49,6 +73,7 @@ std::string ShellQuote(const std::string& text) {
 int Undistort(const std::string& colmap_executable, const std::string& image_path,
               const std::string& input_path, const std::string& output_path,
               const std::vector<std::string>& extra_arguments = {}) {
+  RequireExecutable(colmap_executable);
   std::vector<std::string> arguments = {colmap_executable, "image_undistorter",
                                         "--image_path",    image_path,
                                         "--input_path",    input_path,
@@ -203,6 +228,15 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
                             << " for --image_path " << image_path << " --input_path "
                             << input_path << "; is COLMAP installed (apt-get install colmap)? "
                             << "Nothing was written to " << workspace_path);
+  // colmap image_undistorter passes over a photo it cannot read ("Cannot read image") and
+  // still exits 0; a workspace without it would fail every later command.
+  for (const auto& [id, image] : ReadReconstruction(input_path).images) {
+    THROW_IF(!ExistsFile(JoinPaths(staging.Path(), "images", image.name)),
+             "colmap image_undistorter wrote no image for "
+                 << JoinPaths(image_path, image.name) << ", which the model " << input_path
+                 << " lists: is it missing or unreadable? Nothing was written to "
+                 << workspace_path);
+  }
   if (before_publishing) before_publishing(staging.Path());
   PublishWorkspace(staging.Path(), workspace_path);
 }
@@ -244,7 +278,12 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
     masked.push_back(name);
   }
   list.close();
-  if (masked.empty()) return result;
+  // A mask folder given that matches no photo is a wrong folder or naming, not "0 masks".
+  THROW_IF(masked.empty(), "No mask in " << mask_path << " belongs to a photo of " << input_path
+                                         << " (COLMAP's naming: <photo name>.png, e.g. "
+                                         << JoinPaths(mask_path,
+                                                      workspace.ImageNames().front() + ".png")
+                                         << "); nothing was written");
   // Masks already there may be drawn by hand: replaced only when asked, and named before
   // colmap runs.
   if (!overwrite) {

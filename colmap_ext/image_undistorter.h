@@ -39,7 +39,7 @@ struct MaskUndistortionResult {
 // fails, and the image whose undistorted mask is not its size (another model or options).
 // Every mask is checked before any is written, so a failure leaves the workspace's masks/ as
 // it was; a mask already in masks/ (drawn by hand, perhaps) is an error named before colmap
-// runs, unless `overwrite`.
+// runs, unless `overwrite`. A `mask_path` with no mask of any photo is an error.
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& mask_path,
                                       const std::string& input_path,

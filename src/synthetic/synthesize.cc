@@ -140,6 +140,14 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   THROW_IF(!options.Check(&error), "synthesize: invalid options: " << error);
   Timer total_timer;
   SynthesizeResult result;
+  // A set written over another would keep the old one's depth maps, fusion and truth beside the
+  // new images; named before minutes of rendering.
+  for (const char* part : {"dense", "gt"}) {
+    const std::string path = JoinPaths(options.output_path, part);
+    THROW_IF(ExistsFile(path) || ExistsDir(path),
+             "synthesize: " << path << " exists already: give a new --output_path (or remove "
+                            << "the old set first)");
+  }
 
   // Hair.
   Timer timer;

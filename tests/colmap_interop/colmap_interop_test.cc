@@ -259,6 +259,16 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
 
   const std::string workspace_path = JoinPaths(dir, "dense");
   RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace_path);
+  // A folder with no mask of any photo (masks named without the photo's extension, say).
+  const std::string misnamed = JoinPaths(dir, "misnamed");
+  CreateDirs(misnamed);
+  ASSERT_TRUE(cv::imwrite(JoinPaths(misnamed, "a.png"), photo_mask));
+  const std::string no_mask_error =
+      ErrorOf([&] { UndistortMasks(ColmapExecutable(), misnamed, sparse, workspace_path); });
+  EXPECT_NE(no_mask_error.find("No mask in " + misnamed + " belongs to a photo of " + sparse),
+            std::string::npos)
+      << no_mask_error;
+  EXPECT_FALSE(ExistsDir(JoinPaths(workspace_path, "masks")));
   const MaskUndistortionResult result =
       UndistortMasks(ColmapExecutable(), masks, sparse, workspace_path);
   EXPECT_EQ(result.num_masks, 2);
@@ -380,6 +390,15 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   EXPECT_NE(error.find("exit status 3"), std::string::npos) << error;
   EXPECT_NE(error.find("Nothing was written to " + workspace), std::string::npos) << error;
   EXPECT_EQ(FolderEntries(out), nothing);
+  // A colmap that cannot be run is named before anything starts.
+  EXPECT_EQ(ErrorOf([&] { RunImageUndistorter("/nonexistent/colmap", photos, sparse, workspace); }),
+            "Cannot run /nonexistent/colmap: no such file; install COLMAP (apt-get install "
+            "colmap), or give its path with --colmap_executable");
+  EXPECT_NE(ErrorOf([&] {
+              RunImageUndistorter("no_such_colmap_here", photos, sparse, workspace);
+            }).find("Cannot run no_such_colmap_here: not found in PATH"),
+            std::string::npos);
+  EXPECT_EQ(FolderEntries(out), nothing);
 
   error = ErrorOf([&] {
     RunImageUndistorter(WriteFailingColmap(dir, "interrupted", "kill -INT $PPID $$"), photos,
@@ -395,6 +414,18 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   });
   EXPECT_NE(error.find("the masks failed"), std::string::npos) << error;
   EXPECT_EQ(FolderEntries(out), nothing);
+
+  // A photo that colmap cannot read is passed over with exit status 0: not published.
+  const std::string photo = JoinPaths(photos, model.images.begin()->second.name);
+  std::filesystem::rename(photo, photo + ".away");
+  error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace); });
+  EXPECT_NE(error.find("colmap image_undistorter wrote no image for " + photo +
+                       ", which the model " + sparse + " lists: is it missing or unreadable? "
+                       "Nothing was written to " + workspace),
+            std::string::npos)
+      << error;
+  EXPECT_EQ(FolderEntries(out), nothing);
+  std::filesystem::rename(photo + ".away", photo);
 
   // A hidden folder that a run stopped by a signal left (its process is gone) is removed by
   // the next run; one of a process still running is not.

@@ -186,6 +186,7 @@ TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
             ReadBytes(JoinPaths(second_path, "dense", "images", "g0_c.png")));
 
   options.strands_path = JoinPaths(first_path, "no_such_folder");
+  options.output_path = TempDir("strands_third");
   const std::string message = testing_util::ErrorOf([&] { RunSynthesize(options); });
   EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
   EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
@@ -203,6 +204,13 @@ TEST(Synthesize, DeterministicForASeed) {
   options.output_path = c;
   options.seed = 6;
   RunSynthesize(options);
+  // Not over a set that is there: its maps would stay beside the new images.
+  const std::string before = ReadBytes(JoinPaths(c, "gt", "cameras.npz"));
+  options.seed = 5;
+  EXPECT_EQ(testing_util::ErrorOf([&] { RunSynthesize(options); }),
+            "synthesize: " + JoinPaths(c, "dense") +
+                " exists already: give a new --output_path (or remove the old set first)");
+  EXPECT_EQ(ReadBytes(JoinPaths(c, "gt", "cameras.npz")), before);
   const std::vector<std::string> files = ListFiles(a);
   ASSERT_EQ(files, ListFiles(b));
   EXPECT_GT(files.size(), 20u);
