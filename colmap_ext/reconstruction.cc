@@ -18,26 +18,28 @@ namespace hairmvs {
 static_assert(sizeof(double) == 8, "IEEE-754 double expected");
 
 const std::vector<CameraModelInfo>& CameraModels() {
-  // colmap-formats.md section 4.2 (ids and parameter counts of COLMAP 3.8 through 4.1).
+  // colmap-formats.md section 4.2 (ids, parameter counts and names of COLMAP 3.8 through 4.1;
+  // the focal lengths lead, as in COLMAP's focal_length_idxs).
   static const std::vector<CameraModelInfo> kModels = {
-      {0, "SIMPLE_PINHOLE", 3},
-      {1, "PINHOLE", 4},
-      {2, "SIMPLE_RADIAL", 4},
-      {3, "RADIAL", 5},
-      {4, "OPENCV", 8},
-      {5, "OPENCV_FISHEYE", 8},
-      {6, "FULL_OPENCV", 12},
-      {7, "FOV", 5},
-      {8, "SIMPLE_RADIAL_FISHEYE", 4},
-      {9, "RADIAL_FISHEYE", 5},
-      {10, "THIN_PRISM_FISHEYE", 12},
-      {11, "RAD_TAN_THIN_PRISM_FISHEYE", 16},
-      {12, "SIMPLE_DIVISION", 4},
-      {13, "DIVISION", 5},
-      {14, "SIMPLE_FISHEYE", 3},
-      {15, "FISHEYE", 4},
-      {16, "EUCM", 6},
-      {17, "EQUIRECTANGULAR", 2},
+      {0, "SIMPLE_PINHOLE", 3, 1, "f, cx, cy"},
+      {1, "PINHOLE", 4, 2, "fx, fy, cx, cy"},
+      {2, "SIMPLE_RADIAL", 4, 1, "f, cx, cy, k"},
+      {3, "RADIAL", 5, 1, "f, cx, cy, k1, k2"},
+      {4, "OPENCV", 8, 2, "fx, fy, cx, cy, k1, k2, p1, p2"},
+      {5, "OPENCV_FISHEYE", 8, 2, "fx, fy, cx, cy, k1, k2, k3, k4"},
+      {6, "FULL_OPENCV", 12, 2, "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, k5, k6"},
+      {7, "FOV", 5, 2, "fx, fy, cx, cy, omega"},
+      {8, "SIMPLE_RADIAL_FISHEYE", 4, 1, "f, cx, cy, k"},
+      {9, "RADIAL_FISHEYE", 5, 1, "f, cx, cy, k1, k2"},
+      {10, "THIN_PRISM_FISHEYE", 12, 2, "fx, fy, cx, cy, k1, k2, p1, p2, k3, k4, sx1, sy1"},
+      {11, "RAD_TAN_THIN_PRISM_FISHEYE", 16, 2,
+       "fx, fy, cx, cy, k0, k1, k2, k3, k4, k5, p0, p1, s0, s1, s2, s3"},
+      {12, "SIMPLE_DIVISION", 4, 1, "f, cx, cy, k"},
+      {13, "DIVISION", 5, 2, "fx, fy, cx, cy, k"},
+      {14, "SIMPLE_FISHEYE", 3, 1, "f, cx, cy"},
+      {15, "FISHEYE", 4, 2, "fx, fy, cx, cy"},
+      {16, "EUCM", 6, 2, "fx, fy, cx, cy, alpha, beta"},
+      {17, "EQUIRECTANGULAR", 2, 0, "w, h"},
   };
   return kModels;
 }
@@ -56,14 +58,29 @@ const CameraModelInfo& CameraModelByName(const std::string& name) {
   HAIRMVS_THROW("Unknown camera model name '" << name << "'");
 }
 
+std::string CameraParamName(const CameraModelInfo& info, int index) {
+  std::istringstream names(info.params_info);
+  std::string name;
+  for (int k = 0; std::getline(names, name, ','); ++k) {
+    if (k == index) return StripWhitespace(name);
+  }
+  return "?";
+}
+
 std::string Camera::ModelName() const { return CameraModelById(model_id).name; }
 
 bool Camera::IsPinhole() const { return model_id == 0 || model_id == 1; }
 
+void Camera::RequirePinhole(const std::string& where) const {
+  THROW_IF(!IsPinhole(), (where.empty() ? "Camera " : where + ": camera ")
+                             << camera_id << " has model " << ModelName()
+                             << "; the dense stage needs undistorted PINHOLE or SIMPLE_PINHOLE "
+                                "cameras: run `colmap image_undistorter --output_type COLMAP` "
+                                "first");
+}
+
 Eigen::Matrix3d Camera::CalibrationMatrix() const {
-  THROW_IF(!IsPinhole(), "Camera " << camera_id << " has model " << ModelName()
-                                   << "; the dense stage needs undistorted PINHOLE or "
-                                      "SIMPLE_PINHOLE cameras: run `colmap image_undistorter`");
+  RequirePinhole();
   THROW_IF(params.size() != static_cast<size_t>(CameraModelById(model_id).num_params),
            "Camera " << camera_id << " has " << params.size() << " parameters for "
                      << ModelName());
@@ -217,6 +234,48 @@ void SetCameraParams(Camera* camera, std::vector<double> params, const std::stri
   camera->params = std::move(params);
 }
 
+// What the dense stage cannot use and would otherwise only trip over later (a CHECK on a map
+// of size 0, a negative int size, empty depth maps written over good ones): a width or height
+// outside [1, kMaxCameraSizePx], a parameter that is nan or inf, a focal length that is not > 0.
+// `where` is the file (binary) or file:line (text).
+void ValidateCamera(const Camera& camera, const std::string& where) {
+  const CameraModelInfo& info = CameraModelById(camera.model_id);
+  const std::pair<const char*, uint64_t> sizes[] = {{"width", camera.width},
+                                                    {"height", camera.height}};
+  for (const auto& [what, size] : sizes) {
+    THROW_IF(size < 1 || size > kMaxCameraSizePx,
+             where << ": camera " << camera.camera_id << ": " << what << " " << size
+                   << " is outside 1.." << kMaxCameraSizePx << " px");
+  }
+  for (size_t k = 0; k < camera.params.size(); ++k) {
+    const double value = camera.params[k];
+    const int index = static_cast<int>(k);
+    THROW_IF(!std::isfinite(value),
+             where << ": camera " << camera.camera_id << ": parameter " << index + 1 << " ("
+                   << CameraParamName(info, index) << " of " << info.name << ") is " << value);
+    THROW_IF(index < info.num_focal_params && !(value > 0),
+             where << ": camera " << camera.camera_id << ": focal length "
+                   << CameraParamName(info, index) << " (parameter " << index + 1 << " of "
+                   << info.name << ") is " << value << "; it must be > 0");
+  }
+}
+
+// Image names are unique in a model (COLMAP requires it; maps are named after images).
+// `names` maps the names read so far to their image ids.
+void RequireUniqueName(const Image& image, const std::string& where,
+                       std::map<std::string, uint32_t>* names) {
+  const auto [it, inserted] = names->emplace(image.name, image.image_id);
+  THROW_IF(!inserted, where << ": images " << it->second << " and " << image.image_id
+                            << " both have the name " << image.name
+                            << " (image names must be unique)");
+}
+
+std::map<std::string, uint32_t> ImageNames(const Reconstruction& r) {
+  std::map<std::string, uint32_t> names;
+  for (const auto& [id, image] : r.images) names.emplace(image.name, id);
+  return names;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -239,6 +298,7 @@ void ReadCamerasBinary(std::istream& in, const std::string& source, Reconstructi
     camera.height = ReadBinary<uint64_t>(in, source, "camera height");
     camera.params.resize(info->num_params);
     for (double& p : camera.params) p = ReadBinary<double>(in, source, "camera parameters");
+    ValidateCamera(camera, source);
     THROW_IF(r->cameras.count(camera.camera_id),
              source << ": duplicate camera_id " << camera.camera_id);
     r->cameras[camera.camera_id] = std::move(camera);
@@ -249,6 +309,7 @@ void ReadCamerasBinary(std::istream& in, const std::string& source, Reconstructi
 void ReadImagesBinary(std::istream& in, const std::string& source, Reconstruction* r) {
   const uint64_t num_images = ReadBinary<uint64_t>(in, source, "num_reg_images");
   r->image_order.clear();
+  std::map<std::string, uint32_t> names = ImageNames(*r);
   ReserveBounded(&r->image_order, num_images);
   for (uint64_t i = 0; i < num_images; ++i) {
     Image image;
@@ -283,6 +344,7 @@ void ReadImagesBinary(std::istream& in, const std::string& source, Reconstructio
     }
     THROW_IF(r->images.count(image.image_id),
              source << ": duplicate image_id " << image.image_id);
+    RequireUniqueName(image, source, &names);
     r->image_order.push_back(image.image_id);
     r->images[image.image_id] = std::move(image);
   }
@@ -341,6 +403,7 @@ void ReadCamerasText(std::istream& in, const std::string& source, Reconstruction
       params.push_back(ParseDouble(tokens[k], where, "camera parameter"));
     }
     SetCameraParams(&camera, std::move(params), where);
+    ValidateCamera(camera, where);
     THROW_IF(r->cameras.count(camera.camera_id),
              where << ": duplicate camera_id " << camera.camera_id);
     r->cameras[camera.camera_id] = std::move(camera);
@@ -351,6 +414,7 @@ void ReadImagesText(std::istream& in, const std::string& source, Reconstruction*
   std::string line;
   int line_number = 0;
   r->image_order.clear();
+  std::map<std::string, uint32_t> names = ImageNames(*r);
   while (std::getline(in, line)) {
     ++line_number;
     line = TrimLine(line);
@@ -395,6 +459,7 @@ void ReadImagesText(std::istream& in, const std::string& source, Reconstruction*
     }
     THROW_IF(r->images.count(image.image_id),
              where << ": duplicate image_id " << image.image_id);
+    RequireUniqueName(image, where, &names);
     r->image_order.push_back(image.image_id);
     r->images[image.image_id] = std::move(image);
   }
@@ -606,6 +671,28 @@ bool HasModelFiles(const std::string& dir, const char* ext) {
   return true;
 }
 
+// The files of cameras, images, points3D with extension `ext` that exist in `dir` (`present`)
+// or that do not (!`present`), in that order.
+std::vector<std::string> ModelFilesPresent(const std::string& dir, const char* ext,
+                                           bool present) {
+  std::vector<std::string> names;
+  for (const char* name : {"cameras", "images", "points3D"}) {
+    const std::string file = std::string(name) + ext;
+    if (ExistsFile(JoinPaths(dir, file)) == present) names.push_back(file);
+  }
+  return names;
+}
+
+// "a", "a and b", "a, b and c".
+std::string JoinWithAnd(const std::vector<std::string>& items) {
+  std::string joined;
+  for (size_t i = 0; i < items.size(); ++i) {
+    if (i > 0) joined += i + 1 == items.size() ? " and " : ", ";
+    joined += items[i];
+  }
+  return joined;
+}
+
 }  // namespace
 
 Reconstruction ReadReconstruction(const std::string& dir) {
@@ -626,10 +713,25 @@ Reconstruction ReadReconstruction(const std::string& dir) {
     if (ExistsDir(JoinPaths(dir, "0"))) {
       hint << " (found a sub-folder 0/: the model must sit directly in " << dir << ")";
     }
-    HAIRMVS_THROW("cameras, images, points3D files do not exist at " << dir
-                  << ": need all three of cameras.bin, images.bin, points3D.bin or of "
-                     "cameras.txt, images.txt, points3D.txt"
-                  << hint.str());
+    // Name what is missing of the format more of whose files are there (binary on a tie, as
+    // COLMAP prefers it); the old message only when there is none of the six files.
+    const std::vector<std::string> bin = ModelFilesPresent(dir, ".bin", true);
+    const std::vector<std::string> txt = ModelFilesPresent(dir, ".txt", true);
+    const bool use_binary = bin.size() >= txt.size();
+    const std::vector<std::string>& present = use_binary ? bin : txt;
+    THROW_IF(present.empty(),
+             "cameras, images, points3D files do not exist at "
+                 << dir
+                 << ": need all three of cameras.bin, images.bin, points3D.bin or of "
+                    "cameras.txt, images.txt, points3D.txt"
+                 << hint.str());
+    const std::vector<std::string> missing =
+        ModelFilesPresent(dir, use_binary ? ".bin" : ".txt", false);
+    HAIRMVS_THROW(dir << ": missing " << JoinWithAnd(missing) << " ("
+                      << JoinWithAnd(present) << (present.size() == 1 ? " is" : " are")
+                      << " there; a model needs all three of cameras, images and points3D in one "
+                         "format, .bin or .txt)"
+                      << hint.str());
   }
   const std::string images_file =
       JoinPaths(dir, HasModelFiles(dir, ".bin") ? "images.bin" : "images.txt");

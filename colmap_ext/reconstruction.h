@@ -23,11 +23,21 @@ struct CameraModelInfo {
   int id;
   const char* name;
   int num_params;
+  // The focal lengths are params[0, num_focal_params): f (1), fx and fy (2), or none (0, for
+  // EQUIRECTANGULAR). The readers refuse a focal length that is not > 0.
+  int num_focal_params;
+  const char* params_info;  // parameter names in order, as COLMAP's params_info: "fx, fy, cx, cy"
 };
 const std::vector<CameraModelInfo>& CameraModels();
 // Throws hairmvs::Error for an unknown id / name.
 const CameraModelInfo& CameraModelById(int model_id);
 const CameraModelInfo& CameraModelByName(const std::string& name);
+// The name of parameter `index` (0-based) of the model, e.g. "fy"; "?" when out of range.
+std::string CameraParamName(const CameraModelInfo& info, int index);
+
+// Readers refuse a camera width or height outside [1, kMaxCameraSizePx] (the maps are sized in
+// int, and no real camera is wider).
+constexpr uint64_t kMaxCameraSizePx = 1000000;
 
 struct Camera {
   uint32_t camera_id = 0;
@@ -38,8 +48,12 @@ struct Camera {
 
   std::string ModelName() const;
   bool IsPinhole() const;  // PINHOLE or SIMPLE_PINHOLE: what stereo needs
-  // K for PINHOLE / SIMPLE_PINHOLE. Throws hairmvs::Error for any other model, telling the
-  // user to run `colmap image_undistorter`.
+  // Throws hairmvs::Error unless IsPinhole(), telling the user to run `colmap
+  // image_undistorter`: the one message for a distorted camera. `where` (e.g. "Image a.png in
+  // <workspace>/sparse") leads it when given.
+  void RequirePinhole(const std::string& where = "") const;
+  // K for PINHOLE / SIMPLE_PINHOLE. Throws hairmvs::Error for any other model, as
+  // RequirePinhole() does (without a location: Workspace::CameraOf names the model folder).
   Eigen::Matrix3d CalibrationMatrix() const;
 };
 
@@ -95,8 +109,10 @@ enum class ModelFormat { kBinary, kText };
 
 // Reads `dir`: binary when cameras.bin, images.bin and points3D.bin all exist, else text
 // (COLMAP's rule). Accepts and ignores rigs.* / frames.* (COLMAP 3.12+). Throws hairmvs::Error
-// naming the file and the problem (missing, truncated, trailing bytes, unknown model id,
-// wrong parameter count, malformed line).
+// naming the file (and the line, for text) and the problem (missing files, truncated, trailing
+// bytes, unknown model id, wrong parameter count, malformed line, a camera size outside
+// [1, kMaxCameraSizePx], a parameter that is nan or inf, a focal length that is not > 0, two
+// images with the same name).
 Reconstruction ReadReconstruction(const std::string& dir);
 // Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, as one
 // unit (WriteFilesAtomically): if any file fails, the old model is left whole. Throws

@@ -371,7 +371,29 @@ TEST(Reconstruction, MissingModelFiles) {
   WriteReconstruction(MakePlaneModel(), JoinPaths(partial, "0"), ModelFormat::kBinary);
   WriteFileAtomically(JoinPaths(partial, "cameras.bin"), [](std::ostream& out) { out << "x"; });
   ExpectErrorMentions([&] { ReadReconstruction(partial); },
+                      {partial, "missing images.bin and points3D.bin (cameras.bin is there",
+                       "sub-folder 0/"});
+  // None of the six files: COLMAP's message, and the hint.
+  std::filesystem::remove(JoinPaths(partial, "cameras.bin"));
+  ExpectErrorMentions([&] { ReadReconstruction(partial); },
                       {partial, "do not exist", "sub-folder 0/"});
+}
+
+// A model with one of its files deleted names that file and the two that are there (not "files
+// do not exist"), in either format.
+TEST(Reconstruction, MissingOneModelFileIsNamed) {
+  for (const ModelFormat format : {ModelFormat::kBinary, ModelFormat::kText}) {
+    const std::string ext = format == ModelFormat::kBinary ? ".bin" : ".txt";
+    const std::string dir = MakeTestDir("missing_one" + ext);
+    WriteReconstruction(MakePlaneModel(), dir, format);
+    std::filesystem::remove(JoinPaths(dir, "cameras" + ext));
+    const std::string message = testing_util::ErrorOf([&] { ReadReconstruction(dir); });
+    EXPECT_NE(message.find(dir + ": missing cameras" + ext + " (images" + ext +
+                           " and points3D" + ext + " are there"),
+              std::string::npos)
+        << message;
+    EXPECT_EQ(message.find("do not exist"), std::string::npos) << message;
+  }
 }
 
 TEST(Reconstruction, ImageWithUnknownCameraIsAnError) {
@@ -380,6 +402,188 @@ TEST(Reconstruction, ImageWithUnknownCameraIsAnError) {
   model.images.at(2).camera_id = 99;
   WriteReconstruction(model, dir, ModelFormat::kText);
   ExpectErrorMentions([&] { ReadReconstruction(dir); }, {"images.txt", "camera 99"});
+}
+
+// Writes `model` as a text model in a fresh folder `name`, lets `edit` change the text of
+// `file` (cameras.txt, images.txt), and returns the error of reading it back.
+template <typename Edit>
+std::string ErrorOfEditedTextModel(const std::string& name, const Reconstruction& model,
+                                   const std::string& file, Edit&& edit) {
+  const std::string dir = MakeTestDir(name);
+  WriteReconstruction(model, dir, ModelFormat::kText);
+  std::string text = ReadTextFile(JoinPaths(dir, file));
+  edit(&text);
+  WriteFileAtomically(JoinPaths(dir, file), [&](std::ostream& out) { out << text; });
+  return testing_util::ErrorOf([&] { ReadReconstruction(dir); });
+}
+
+// Replaces the first occurrence of `from` in `text` (the test fails when there is none).
+void ReplaceOnce(std::string* text, const std::string& from, const std::string& to) {
+  const size_t pos = text->find(from);
+  ASSERT_NE(pos, std::string::npos) << from;
+  text->replace(pos, from.size(), to);
+}
+
+// The line number (1-based) of the line of `text` that starts with `prefix`.
+int LineStartingWith(const std::string& text, const std::string& prefix) {
+  std::istringstream lines(text);
+  std::string line;
+  for (int n = 1; std::getline(lines, line); ++n) {
+    if (line.rfind(prefix, 0) == 0) return n;
+  }
+  return -1;
+}
+
+// COLMAP requires unique image names (depth maps are named after them); a second image with a
+// name already taken is refused, naming both ids (and, in text, the line of the second).
+TEST(Reconstruction, DuplicateImageNamesAreRefused) {
+  Reconstruction model = MakePlaneModel();
+  model.images.at(3).name = "a.png";  // images 1 and 3
+  std::stringstream bytes;
+  WriteImagesBinary(model, bytes);
+  Reconstruction r;
+  std::string message = testing_util::ErrorOf([&] { ReadImagesBinary(bytes, "images.bin", &r); });
+  EXPECT_NE(message.find("images.bin: images 1 and 3 both have the name a.png"),
+            std::string::npos)
+      << message;
+
+  std::stringstream text;
+  WriteImagesText(model, text);
+  const int line = LineStartingWith(text.str(), "3 ");
+  ASSERT_GT(line, 0);
+  Reconstruction t;
+  message = testing_util::ErrorOf([&] { ReadImagesText(text, "sparse/images.txt", &t); });
+  EXPECT_NE(message.find("sparse/images.txt:" + std::to_string(line) +
+                         ": images 1 and 3 both have the name a.png"),
+            std::string::npos)
+      << message;
+
+  // Through the folder reader too.
+  const std::string dir = MakeTestDir("duplicate_names");
+  WriteReconstruction(model, dir, ModelFormat::kBinary);
+  message = testing_util::ErrorOf([&] { ReadReconstruction(dir); });
+  EXPECT_NE(message.find(JoinPaths(dir, "images.bin") + ": images 1 and 3"), std::string::npos)
+      << message;
+}
+
+// A width or height of 0 (a CHECK on an empty map later) or beyond kMaxCameraSizePx (an int
+// that turns negative) is refused at reading, naming the file, line and camera.
+TEST(Reconstruction, CameraSizeOutsideLimitsIsRefused) {
+  const Reconstruction model = MakePlaneModel();
+  // Text: width 0, height 0. The first camera's line is "1 PINHOLE 64 48 ...".
+  std::string message = ErrorOfEditedTextModel(
+      "camera_width_0", model, "cameras.txt",
+      [](std::string* text) { ReplaceOnce(text, "\n1 PINHOLE 64 48 ", "\n1 PINHOLE 0 48 "); });
+  EXPECT_NE(message.find("cameras.txt:4: camera 1: width 0 is outside 1..1000000"),
+            std::string::npos)
+      << message;
+  message = ErrorOfEditedTextModel(
+      "camera_height_0", model, "cameras.txt",
+      [](std::string* text) { ReplaceOnce(text, "\n2 PINHOLE 64 48 ", "\n2 PINHOLE 64 0 "); });
+  EXPECT_NE(message.find("cameras.txt:5: camera 2: height 0 is outside 1..1000000"),
+            std::string::npos)
+      << message;
+  // Binary: a height above INT_MAX (uint64 in the file).
+  Reconstruction huge = model;
+  huge.cameras.at(2).height = uint64_t{1} << 31;
+  const std::string dir = MakeTestDir("camera_height_huge");
+  WriteReconstruction(huge, dir, ModelFormat::kBinary);
+  message = testing_util::ErrorOf([&] { ReadReconstruction(dir); });
+  EXPECT_NE(message.find(JoinPaths(dir, "cameras.bin") + ": camera 2: height 2147483648 is "
+                                                         "outside 1..1000000"),
+            std::string::npos)
+      << message;
+  // The largest size allowed reads.
+  huge.cameras.at(2).height = kMaxCameraSizePx;
+  WriteReconstruction(huge, dir, ModelFormat::kBinary);
+  EXPECT_EQ(ReadReconstruction(dir).cameras.at(2).height, kMaxCameraSizePx);
+}
+
+// A parameter that is nan or inf (strtod parses both) is refused for any model, and a focal
+// length that is not > 0 for every model: the stereo would write empty maps over good ones.
+TEST(Reconstruction, NonFiniteCameraParametersAndBadFocalLengthsAreRefused) {
+  const Reconstruction model = MakePlaneModel();  // "1 PINHOLE 64 48 50 50 32 24"
+  struct Case {
+    std::string from, to, expected;
+  };
+  const std::vector<Case> cases = {
+      {" 64 48 50 50 32 24", " 64 48 50 nan 32 24", "camera 1: parameter 2 (fy of PINHOLE) is nan"},
+      {" 64 48 50 50 32 24", " 64 48 50 50 inf 24", "camera 1: parameter 3 (cx of PINHOLE) is inf"},
+      {" 64 48 50 50 32 24", " 64 48 50 50 32 -inf",
+       "camera 1: parameter 4 (cy of PINHOLE) is -inf"},
+      {" 64 48 50 50 32 24", " 64 48 0 50 32 24",
+       "camera 1: focal length fx (parameter 1 of PINHOLE) is 0; it must be > 0"},
+      {" 64 48 50 50 32 24", " 64 48 50 -50 32 24",
+       "camera 1: focal length fy (parameter 2 of PINHOLE) is -50; it must be > 0"},
+      {"1 PINHOLE 64 48 50 50 32 24", "1 SIMPLE_PINHOLE 64 48 -1 32 24",
+       "camera 1: focal length f (parameter 1 of SIMPLE_PINHOLE) is -1"},
+      {"1 PINHOLE 64 48 50 50 32 24", "1 SIMPLE_RADIAL 64 48 0 32 24 0.1",
+       "camera 1: focal length f (parameter 1 of SIMPLE_RADIAL)"},
+      {"1 PINHOLE 64 48 50 50 32 24", "1 OPENCV 64 48 50 0 32 24 0 0 0 0",
+       "camera 1: focal length fy (parameter 2 of OPENCV)"},
+      {"1 PINHOLE 64 48 50 50 32 24", "1 OPENCV 64 48 50 50 32 24 0 nan 0 0",
+       "camera 1: parameter 6 (k2 of OPENCV) is nan"},
+      {"1 PINHOLE 64 48 50 50 32 24", "1 FULL_OPENCV 64 48 50 -2 32 24 0 0 0 0 0 0 0 0",
+       "camera 1: focal length fy (parameter 2 of FULL_OPENCV)"},
+  };
+  int i = 0;
+  for (const Case& c : cases) {
+    const std::string message = ErrorOfEditedTextModel(
+        "camera_params_" + std::to_string(i++), model, "cameras.txt",
+        [&](std::string* text) { ReplaceOnce(text, c.from, c.to); });
+    EXPECT_NE(message.find("cameras.txt:4: " + c.expected), std::string::npos)
+        << c.to << ": " << message;
+  }
+  // Every model with a focal length refuses 0 there, in binary too.
+  for (const CameraModelInfo& info : CameraModels()) {
+    for (int k = 0; k < info.num_focal_params; ++k) {
+      Reconstruction r = model;
+      Camera& camera = r.cameras.at(1);
+      camera.model_id = info.id;
+      camera.params.assign(info.num_params, 10.0);
+      camera.params[k] = 0.0;
+      std::stringstream bytes;
+      WriteCamerasBinary(r, bytes);
+      Reconstruction read;
+      const std::string message =
+          testing_util::ErrorOf([&] { ReadCamerasBinary(bytes, "cameras.bin", &read); });
+      EXPECT_NE(message.find("cameras.bin: camera 1: focal length"), std::string::npos)
+          << info.name << ": " << message;
+    }
+    // A nan in the last parameter, whatever it is.
+    Reconstruction r = model;
+    Camera& camera = r.cameras.at(1);
+    camera.model_id = info.id;
+    camera.params.assign(info.num_params, 10.0);
+    camera.params.back() = std::nan("");
+    std::stringstream bytes;
+    WriteCamerasBinary(r, bytes);
+    Reconstruction read;
+    const std::string message =
+        testing_util::ErrorOf([&] { ReadCamerasBinary(bytes, "cameras.bin", &read); });
+    EXPECT_NE(message.find("cameras.bin: camera 1: parameter " + std::to_string(info.num_params)),
+              std::string::npos)
+        << info.name << ": " << message;
+    EXPECT_NE(message.find("is nan"), std::string::npos) << info.name << ": " << message;
+  }
+}
+
+TEST(CameraModels, FocalLengthsAndParameterNames) {
+  EXPECT_EQ(CameraModelByName("SIMPLE_PINHOLE").num_focal_params, 1);
+  EXPECT_EQ(CameraModelByName("PINHOLE").num_focal_params, 2);
+  EXPECT_EQ(CameraModelByName("RADIAL").num_focal_params, 1);
+  EXPECT_EQ(CameraModelByName("FULL_OPENCV").num_focal_params, 2);
+  EXPECT_EQ(CameraModelByName("EQUIRECTANGULAR").num_focal_params, 0);
+  for (const CameraModelInfo& info : CameraModels()) {
+    // params_info has one name per parameter; the focal lengths lead.
+    EXPECT_NE(CameraParamName(info, info.num_params - 1), "?") << info.name;
+    EXPECT_EQ(CameraParamName(info, info.num_params), "?") << info.name;
+    for (int k = 0; k < info.num_focal_params; ++k) {
+      EXPECT_EQ(CameraParamName(info, k)[0], 'f') << info.name;
+    }
+    EXPECT_NE(CameraParamName(info, info.num_focal_params)[0], 'f') << info.name;
+  }
+  EXPECT_EQ(CameraParamName(CameraModelByName("OPENCV"), 7), "p2");
 }
 
 }  // namespace

@@ -83,10 +83,8 @@ const Image& Workspace::ImageByName(const std::string& name) const {
 const Camera& Workspace::CameraOf(const std::string& name) const {
   const Image& image = ImageByName(name);
   const Camera& camera = model_.cameras.at(image.camera_id);
-  THROW_IF(!camera.IsPinhole(),
-           "Image " << name << " in " << path_ << " has a " << camera.ModelName()
-                    << " camera; the dense stage needs PINHOLE or SIMPLE_PINHOLE: run `colmap "
-                       "image_undistorter --output_type COLMAP` first");
+  // Names the model folder: the camera's model is in sparse/, not in the images.
+  camera.RequirePinhole("Image " + name + " in " + JoinPaths(path_, "sparse"));
   return camera;
 }
 

@@ -97,6 +97,27 @@ TEST(Workspace, BadWorkspaces) {
             std::string::npos);
 }
 
+// The message for a distorted camera names the image, the model folder it is described in, the
+// camera and its model: the one message CalibrationMatrix gives too, with the location.
+TEST(Workspace, DistortedCameraNamesTheModelFolder) {
+  const std::string dir = MakeTestDir("ws_distorted");
+  Reconstruction model = MakePlaneModel();
+  model.cameras.at(2).model_id = 4;  // OPENCV: fx, fy, cx, cy, k1, k2, p1, p2
+  model.cameras.at(2).params = {50, 50, 32, 24, 0.01, 0, 0, 0};
+  WriteTestWorkspace(dir, model);
+  const Workspace ws = Workspace::Read(dir);
+  const std::string message = ErrorOf([&] { ws.RequireUndistortedCameras(); });
+  EXPECT_NE(message.find("Image b.png in " + JoinPaths(dir, "sparse") +
+                         ": camera 2 has model OPENCV; the dense stage needs undistorted "
+                         "PINHOLE or SIMPLE_PINHOLE cameras: run `colmap image_undistorter"),
+            std::string::npos)
+      << message;
+  const std::string bare = ErrorOf([&] { model.cameras.at(2).CalibrationMatrix(); });
+  EXPECT_NE(bare.find("Camera 2 has model OPENCV; the dense stage needs undistorted"),
+            std::string::npos)
+      << bare;
+}
+
 TEST(Images, GrayRgbAndSixteenBit) {
   const std::string dir = MakeTestDir("images");
   cv::Mat bgr(2, 3, CV_8UC3, cv::Scalar(0, 0, 0));
