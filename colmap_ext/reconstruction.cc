@@ -69,14 +69,31 @@ std::string CameraParamName(const CameraModelInfo& info, int index) {
 
 std::string Camera::ModelName() const { return CameraModelById(model_id).name; }
 
-bool Camera::IsPinhole() const { return model_id == 0 || model_id == 1; }
+// SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV: a pinhole (f or fx, fy, then cx, cy) with lens
+// distortion after it, which is a pinhole when all 0. Not the fisheye models, whose projection
+// is not perspective even without distortion.
+namespace {
+bool IsDistortedPinholeModel(int model_id) {
+  return model_id == 2 || model_id == 3 || model_id == 4 || model_id == 6;
+}
+}  // namespace
+
+bool Camera::IsPinhole() const {
+  if (model_id == 0 || model_id == 1) return true;
+  if (!IsDistortedPinholeModel(model_id)) return false;
+  const size_t first_distortion = CameraModelById(model_id).num_focal_params + 2;
+  return params.size() == static_cast<size_t>(CameraModelById(model_id).num_params) &&
+         std::all_of(params.begin() + first_distortion, params.end(),
+                     [](double p) { return p == 0.0; });
+}
 
 void Camera::RequirePinhole(const std::string& where) const {
   THROW_IF(!IsPinhole(), (where.empty() ? "Camera " : where + ": camera ")
                              << camera_id << " has model " << ModelName()
+                             << (IsDistortedPinholeModel(model_id) ? " with distortion" : "")
                              << "; the dense stage needs undistorted PINHOLE or SIMPLE_PINHOLE "
-                                "cameras: run `colmap image_undistorter --output_type COLMAP` "
-                                "first");
+                                "cameras (or a model whose distortion is all 0): run `colmap "
+                                "image_undistorter --output_type COLMAP` first");
 }
 
 Eigen::Matrix3d Camera::CalibrationMatrix() const {
@@ -85,16 +102,11 @@ Eigen::Matrix3d Camera::CalibrationMatrix() const {
            "Camera " << camera_id << " has " << params.size() << " parameters for "
                      << ModelName());
   Eigen::Matrix3d K = Eigen::Matrix3d::Identity();
-  if (model_id == 0) {
-    K(0, 0) = K(1, 1) = params[0];
-    K(0, 2) = params[1];
-    K(1, 2) = params[2];
-  } else {
-    K(0, 0) = params[0];
-    K(1, 1) = params[1];
-    K(0, 2) = params[2];
-    K(1, 2) = params[3];
-  }
+  const int num_focal = CameraModelById(model_id).num_focal_params;  // 1 or 2 here
+  K(0, 0) = params[0];
+  K(1, 1) = params[num_focal - 1];
+  K(0, 2) = params[num_focal];
+  K(1, 2) = params[num_focal + 1];
   return K;
 }
 

@@ -47,12 +47,17 @@ struct Camera {
   std::vector<double> params;
 
   std::string ModelName() const;
-  bool IsPinhole() const;  // PINHOLE or SIMPLE_PINHOLE: what stereo needs
+  // What the dense stage takes: PINHOLE or SIMPLE_PINHOLE, or a perspective model whose
+  // distortion parameters are all 0 (SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV), which colmap
+  // image_undistorter copies through as it is (its Camera::IsUndistorted), and so is in COLMAP
+  // workspaces that colmap patch_match_stereo reads.
+  bool IsPinhole() const;
   // Throws hairmvs::Error unless IsPinhole(), telling the user to run `colmap
   // image_undistorter`: the one message for a distorted camera. `where` (e.g. "Image a.png in
   // <workspace>/sparse") leads it when given.
   void RequirePinhole(const std::string& where = "") const;
-  // K for PINHOLE / SIMPLE_PINHOLE. Throws hairmvs::Error for any other model, as
+  // K (from f or fx, fy, then cx, cy) for a camera that IsPinhole(). Throws hairmvs::Error for
+  // any other, as
   // RequirePinhole() does (without a location: Workspace::CameraOf names the model folder).
   Eigen::Matrix3d CalibrationMatrix() const;
 };

@@ -83,9 +83,31 @@ TEST(Camera, CalibrationMatrix) {
   K = camera.CalibrationMatrix();
   EXPECT_EQ(K(1, 1), 90);
   EXPECT_EQ(K(1, 2), 23);
+  // A perspective model without distortion, as colmap image_undistorter copies it through.
+  camera.model_id = 4;  // OPENCV
+  camera.params = {100, 90, 31, 23, 0, 0, 0, 0};
+  EXPECT_TRUE(camera.IsPinhole());
+  K = camera.CalibrationMatrix();
+  EXPECT_EQ(K(0, 0), 100);
+  EXPECT_EQ(K(1, 1), 90);
+  EXPECT_EQ(K(0, 2), 31);
+  EXPECT_EQ(K(1, 2), 23);
+  camera.model_id = 2;  // SIMPLE_RADIAL
+  camera.params = {100, 32, 24, 0};
+  K = camera.CalibrationMatrix();
+  EXPECT_EQ(K(1, 1), 100);
+  EXPECT_EQ(K(0, 2), 32);
+  EXPECT_EQ(K(1, 2), 24);
+  // With distortion, or a fisheye model (not perspective even without it): refused.
+  camera.params = {100, 32, 24, 0.01};
+  ExpectErrorMentions([&] { camera.CalibrationMatrix(); },
+                      {"SIMPLE_RADIAL", "with distortion", "image_undistorter"});
   camera.model_id = 4;
-  camera.params.assign(8, 0.0);
+  camera.params = {100, 90, 31, 23, 0, 0, 1e-4, 0};
   ExpectErrorMentions([&] { camera.CalibrationMatrix(); }, {"OPENCV", "image_undistorter"});
+  camera.model_id = 5;  // OPENCV_FISHEYE
+  camera.params = {100, 90, 31, 23, 0, 0, 0, 0};
+  EXPECT_FALSE(camera.IsPinhole());
 }
 
 TEST(Reconstruction, BinaryRoundTripThroughMemory) {

@@ -339,6 +339,8 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
                                                    const SourceViewOptions& options) {
   std::string error;
   THROW_IF(!options.Check(&error), "Invalid source view options: " << error);
+  // The epipolar directions need every camera's K: a distorted one is named with its folder.
+  ws.RequireUndistortedCameras();
   const Reconstruction& model = ws.Model();
   const std::string cfg_path = options.config_path.empty()
                                    ? JoinPaths(ws.StereoPath(), "patch-match.cfg")

@@ -108,12 +108,13 @@ TEST(Workspace, DistortedCameraNamesTheModelFolder) {
   const Workspace ws = Workspace::Read(dir);
   const std::string message = ErrorOf([&] { ws.RequireUndistortedCameras(); });
   EXPECT_NE(message.find("Image b.png in " + JoinPaths(dir, "sparse") +
-                         ": camera 2 has model OPENCV; the dense stage needs undistorted "
-                         "PINHOLE or SIMPLE_PINHOLE cameras: run `colmap image_undistorter"),
+                         ": camera 2 has model OPENCV with distortion; the dense stage needs "
+                         "undistorted PINHOLE or SIMPLE_PINHOLE cameras (or a model whose "
+                         "distortion is all 0): run `colmap image_undistorter"),
             std::string::npos)
       << message;
   const std::string bare = ErrorOf([&] { model.cameras.at(2).CalibrationMatrix(); });
-  EXPECT_NE(bare.find("Camera 2 has model OPENCV; the dense stage needs undistorted"),
+  EXPECT_NE(bare.find("Camera 2 has model OPENCV with distortion; the dense stage needs"),
             std::string::npos)
       << bare;
 }
