@@ -13,6 +13,8 @@
 
 namespace hairmvs {
 
+class StageTimings;  // src/core/timer.h
+
 struct ImportGroundTruthOptions {
   // Standard deviation of the Gaussian noise added to every written depth (0 = exact).
   double noise_m = 0.0;
@@ -170,9 +172,11 @@ struct DepthEvaluationResult {
   std::string Table() const;
 };
 
+// `timings`, when given, gets the time of each stage (reading, per-pixel errors, 3D distances...).
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
-                                        const DepthEvaluationOptions& options);
+                                        const DepthEvaluationOptions& options,
+                                        StageTimings* timings = nullptr);
 
 // The data term alone, without the MRF: per coarse pixel of a view's cost volume as
 // `orientation_stereo --OrientationStereo.write_cost_volume 1` writes it, where its cheapest
@@ -227,7 +231,8 @@ struct DataTermEvaluationResult {
 
 DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
                                           const std::string& ground_truth_path,
-                                          const DataTermEvaluationOptions& options);
+                                          const DataTermEvaluationOptions& options,
+                                          StageTimings* timings = nullptr);
 
 struct MeshEvaluationOptions {
   // Accuracy also from points sampled on the faces, about this far apart (0 = vertices only).
@@ -282,6 +287,7 @@ struct MeshEvaluationResult {
 MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& ground_truth_path,
                                   const std::string& workspace_path,
-                                  const MeshEvaluationOptions& options);
+                                  const MeshEvaluationOptions& options,
+                                  StageTimings* timings = nullptr);
 
 }  // namespace hairmvs

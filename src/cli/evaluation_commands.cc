@@ -60,10 +60,9 @@ int RunWorkspaceEvaluation(int argc, char** argv, const char* name, const char* 
   AddPlain(&parser, &options);
   if (!parser.Parse(argc, argv)) return 0;
   CheckOrThrow(options);
-  Timer timer;
-  const auto result = evaluate(workspace_path, ground_truth_path, options);
-  std::printf("%s", result.Table().c_str());
-  std::printf("Evaluated %zu views in %.1f s\n", result.views.size(), timer.ElapsedSeconds());
+  StageTimings timings;
+  const auto result = evaluate(workspace_path, ground_truth_path, options, &timings);
+  std::printf("%s%s", result.Table().c_str(), RunSummary(timings).c_str());
   return 0;
 }
 
@@ -80,8 +79,8 @@ int RunEvaluateDepth(int argc, char** argv) {
       "dense workspace with depth maps",
       // A lambda: EvaluateDepthMaps is overloaded (also with a prebuilt strand index).
       [](const std::string& workspace, const std::string& truth,
-         const DepthEvaluationOptions& options) {
-        return EvaluateDepthMaps(workspace, truth, options);
+         const DepthEvaluationOptions& options, StageTimings* timings) {
+        return EvaluateDepthMaps(workspace, truth, options, timings);
       });
 }
 
@@ -114,10 +113,10 @@ int RunEvaluateMesh(int argc, char** argv) {
   AddPlain(&parser, &options);
   if (!parser.Parse(argc, argv)) return 0;
   CheckOrThrow(options);
-  Timer timer;
+  StageTimings timings;
   const MeshEvaluationResult result =
-      EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options);
-  std::printf("%sEvaluated in %.1f s\n", result.Report().c_str(), timer.ElapsedSeconds());
+      EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, &timings);
+  std::printf("%s%s", result.Report().c_str(), RunSummary(timings).c_str());
   return 0;
 }
 

@@ -29,7 +29,7 @@ int RunTemplateFusionCommand(int argc, char** argv) {
   THROW_IF(!options.Check(&error), "invalid option: " << error);
   StageTimings timings;
   const TemplateFusionResult result = RunTemplateFusion(workspace_path, options, &timings);
-  std::printf("%s\n%s\n", result.BriefReport().c_str(), timings.Table().c_str());
+  std::printf("%s\n%s", result.BriefReport().c_str(), RunSummary(timings).c_str());
   return 0;
 }
 

@@ -49,7 +49,7 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
   parser.Add("write_png", &run_options.write_png, "also write <...>.l<k>.png pictures");
   parser.Add("skip_up_to_date", &run_options.skip_up_to_date,
              "keep the images whose cached fields' provenance holds (0: compute all again)");
-  parser.Add("timing", &timing, "print the per-stage timing table");
+  parser.Add("timing", &timing, "print the per-stage timing table and the peak memory");
   parser.AddSection("OrientationField", &options);
   parser.AddSection("OpenCL", &opencl_options);
   if (!parser.Parse(argc, argv)) return 0;
@@ -61,7 +61,7 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
   const OrientationFieldsResult result =
       hairmvs::RunOrientationFields(workspace_path, options, run_options, &timings);
   std::printf("%s\n", result.BriefReport().c_str());
-  if (timing) std::printf("%s", timings.Table().c_str());
+  if (timing) std::printf("%s", RunSummary(timings).c_str());
   return 0;
 }
 

@@ -194,8 +194,8 @@ int RunPipeline(int argc, char** argv) {
     }
   }
 
-  std::printf("%s", timings.Table("hairmvs pipeline: time per stage").c_str());
-  std::printf("peak memory: %.0f MiB, wall time: %.1f s\n", PeakResidentMemoryMiB(),
+  std::printf("%sWall time: %.1f s\n",
+              RunSummary(timings, "hairmvs pipeline: time per stage").c_str(),
               total.ElapsedSeconds());
   // What this run wrote, to look at.
   const char* w = workspace_path.c_str();

@@ -12,14 +12,14 @@
 #include "src/cli/command_registry.h"
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
+#include "src/core/timer.h"
 #include "src/opencl/opencl_options.h"
 
 namespace hairmvs {
 namespace {
 
 void PrintSummary(const OrientationStereoResult& result, const StageTimings& timings) {
-  std::printf("%s\n%s", result.BriefReport().c_str(), timings.Table().c_str());
-  std::printf("Peak resident memory: %.1f MiB\n", PeakResidentMemoryMiB());
+  std::printf("%s\n%s", result.BriefReport().c_str(), RunSummary(timings).c_str());
 }
 
 int RunOrientationStereoCommand(int argc, char** argv) {

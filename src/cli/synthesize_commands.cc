@@ -7,6 +7,7 @@
 #include "hairmvs/synthesize.h"
 #include "src/cli/command_registry.h"
 #include "src/core/option_parser.h"
+#include "src/core/timer.h"
 
 namespace hairmvs {
 namespace {
@@ -22,7 +23,11 @@ int RunSynthesizeCommand(int argc, char** argv) {
   });
   if (!parser.Parse(argc, argv)) return 0;
   const SynthesizeResult result = RunSynthesize(options);
-  std::printf("%s\n", result.BriefReport().c_str());
+  StageTimings timings;
+  timings.Add("hair", result.seconds_hair);
+  timings.Add("render", result.seconds_render);
+  timings.Add("write", result.seconds_write);
+  std::printf("%s\n%s", result.BriefReport().c_str(), RunSummary(timings).c_str());
   return 0;
 }
 

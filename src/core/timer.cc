@@ -63,6 +63,12 @@ std::string StageTimings::Table(const std::string& title) const {
   return out.str();
 }
 
+std::string RunSummary(const StageTimings& timings, const std::string& title) {
+  char line[64];
+  std::snprintf(line, sizeof(line), "Peak resident memory: %.1f MiB\n", PeakResidentMemoryMiB());
+  return timings.Table(title) + line;
+}
+
 double PeakResidentMemoryMiB() {
   std::ifstream status("/proc/self/status");
   std::string key;

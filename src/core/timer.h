@@ -54,7 +54,25 @@ class ScopedStageTimer {
   Timer timer_;
 };
 
+// Splits consecutive stages' time among them: Lap("read") adds the seconds since the previous
+// Lap (or construction) to stage "read" of `timings` (nothing when it is null).
+class StageLaps {
+ public:
+  explicit StageLaps(StageTimings* timings) : timings_(timings) {}
+  void Lap(const std::string& stage) {
+    if (timings_ != nullptr) timings_->Add(stage, timer_.ElapsedSeconds());
+    timer_.Restart();
+  }
+
+ private:
+  StageTimings* timings_;
+  Timer timer_;
+};
+
 // Peak resident memory of this process in MiB (from /proc/self/status VmHWM).
 double PeakResidentMemoryMiB();
+// How a long command ends: the table of `timings` under `title`, then the line
+// "Peak resident memory: <MiB> MiB" (which scripts/evaluate_stereo.sh reads).
+std::string RunSummary(const StageTimings& timings, const std::string& title = "Timing per stage");
 
 }  // namespace hairmvs

@@ -179,9 +179,11 @@ std::string DataTermEvaluationResult::Table() const {
 
 DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
                                           const std::string& ground_truth_path,
-                                          const DataTermEvaluationOptions& options) {
+                                          const DataTermEvaluationOptions& options,
+                                          StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   const Workspace ws = Workspace::Read(workspace_path);
   const std::vector<std::string> names = ViewsToEvaluate(
       ws, options.image_names, [&](const std::string& name) { return ws.CostVolumePath(name); },
@@ -202,6 +204,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
              ws.CostVolumePath(name) << ": a cost volume needs at least 2 labels");
     DataTermSamples samples;
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
+    laps.Lap("read cost volumes and truth");
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
     const StereoCamera view_camera = ws.ViewCamera(name);
     const StereoCamera truth_camera =
@@ -215,6 +218,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);
+    laps.Lap("cheapest labels against the truth");
   }
   progress.Finish();
   result.overall = Summarize("overall", pooled);
@@ -230,6 +234,7 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
   result.json_path =
       JoinPaths(EvaluationFolder(ws, options.output_path), "data_term_evaluation.json");
   WriteJsonSummary(result.json_path, json);
+  laps.Lap("summary");
   return result;
 }
 

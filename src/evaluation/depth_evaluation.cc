@@ -194,24 +194,29 @@ std::string DepthEvaluationResult::Table() const {
 
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
-                                        const DepthEvaluationOptions& options) {
+                                        const DepthEvaluationOptions& options,
+                                        StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
   Timer timer;
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
   LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
             << strand_distance.NumSamples() << " centreline samples (" << std::fixed
             << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
-  return EvaluateDepthMaps(workspace_path, ground_truth_path, options, strand_distance);
+  laps.Lap("true strands");
+  return EvaluateDepthMaps(workspace_path, ground_truth_path, options, strand_distance, timings);
 }
 
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
                                         const DepthEvaluationOptions& options,
-                                        const StrandDistance& strand_distance) {
+                                        const StrandDistance& strand_distance,
+                                        StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   const Workspace ws = Workspace::Read(workspace_path);
   const std::vector<std::string> names = ViewsToEvaluate(
       ws, options.image_names,
@@ -233,6 +238,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     THROW_IF(depth.Channels() != 1,
              ws.DepthMapPath(name, options.depth_type) << ": a depth map has 1 channel");
     const GroundTruthView gt = ReadGroundTruthView(ground_truth_path, name);
+    laps.Lap("read maps and truth");
     const int width = depth.Width(), height = depth.Height();
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
     const StereoCamera camera =
@@ -316,9 +322,11 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
       std::shuffle(points.begin(), points.end(), rng);
       points.resize(options.max_points_3d_per_view);
     }
+    laps.Lap("per-pixel errors");
     progress.Stage("3D distances");
     samples.distances_3d_m = strand_distance.Distances(points);
     result.views.push_back(Summarize(name, samples));
+    laps.Lap("3D distances");
 
     if (options.write_error_images) {
       cv::Mat signed_image = error_image.clone();
@@ -339,6 +347,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         const std::string png = JoinPaths(output_path, name + suffix);
         WriteImage(png, *image);
       }
+      laps.Lap("error pictures");
     }
     pooled.Append(samples);
   }
@@ -358,6 +367,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   for (const DepthMetrics& m : result.views) json["views"].push_back(ToJson(m));
   result.json_path = JoinPaths(output_path, "depth_evaluation.json");
   WriteJsonSummary(result.json_path, json);
+  laps.Lap("summary");
   return result;
 }
 

@@ -14,11 +14,13 @@ namespace hairmvs {
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
                                         const DepthEvaluationOptions& options,
-                                        const StrandDistance& strands);
+                                        const StrandDistance& strands,
+                                        StageTimings* timings = nullptr);
 MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& ground_truth_path,
                                   const std::string& workspace_path,
                                   const MeshEvaluationOptions& options,
-                                  const StrandDistance& strands);
+                                  const StrandDistance& strands,
+                                  StageTimings* timings = nullptr);
 
 }  // namespace hairmvs

@@ -77,7 +77,8 @@ std::string MeshEvaluationResult::Report() const {
 MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& ground_truth_path,
                                   const std::string& workspace_path,
-                                  const MeshEvaluationOptions& options) {
+                                  const MeshEvaluationOptions& options,
+                                  StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
   Timer timer;
@@ -85,16 +86,20 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
   LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
             << timer.ElapsedSeconds() << " s)";
-  return EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, strand_distance);
+  if (timings != nullptr) timings->Add("true strands", timer.ElapsedSeconds());
+  return EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, strand_distance,
+                      timings);
 }
 
 MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& ground_truth_path,
                                   const std::string& workspace_path,
                                   const MeshEvaluationOptions& options,
-                                  const StrandDistance& strand_distance) {
+                                  const StrandDistance& strand_distance,
+                                  StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   const TriangleMesh mesh = ReadMeshPly(mesh_path);
   THROW_IF(mesh.vertices.empty() || mesh.faces.empty(),
            mesh_path << ": the mesh has " << mesh.vertices.size() << " vertices and "
@@ -115,6 +120,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
     result.accuracy_surface = SummarizeDistances(strand_distance.Distances(samples));
   }
 
+  laps.Lap("accuracy");
   // Completeness: the visible true hair surface (hair pixels of the true depth maps,
   // back-projected with the true cameras) to the mesh surface.
   const GroundTruthCameras cameras = ReadGroundTruthCameras(ground_truth_path);
@@ -141,6 +147,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
     std::shuffle(surface.begin(), surface.end(), rng);
     surface.resize(options.max_ground_truth_points);
   }
+  laps.Lap("true visible surface");
   progress.Start(2, "completeness: " + std::to_string(surface.size()) +
                         " true surface points to the mesh");
   std::vector<Eigen::Vector3d> queries;
@@ -177,6 +184,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   json["completeness_5mm"] = result.completeness_5mm;
   json["num_views"] = names.size();
   WriteJsonSummary(result.json_path, json);
+  laps.Lap("completeness");
   return result;
 }
 

@@ -129,9 +129,7 @@ std::string SynthesizeResult::BriefReport() const {
   s << "Synthesized " << num_views << " views of " << width << " x " << height << " px, "
     << num_strands << " strands (" << num_strand_points << " points); " << num_sparse_points
     << " sparse points (mean track length " << mean_track_length << "); hair on "
-    << 100.0 * hair_pixel_fraction << "% of the pixels.\n"
-    << "Time: hair " << seconds_hair << " s, render " << seconds_render << " s, write "
-    << seconds_write << " s, total " << seconds_total << " s.";
+    << 100.0 * hair_pixel_fraction << "% of the pixels.";
   return s.str();
 }
 

@@ -37,12 +37,21 @@ CommandOutput RunHairmvs(const std::string& args) {
   return output;
 }
 
+// A long command ends with its stage table, naming `stages`, and its peak memory.
+void ExpectRunSummary(const std::string& text, const std::vector<std::string>& stages) {
+  for (const std::string& stage : stages) {
+    EXPECT_NE(text.find("\n  " + stage + " "), std::string::npos) << stage << " in:\n" << text;
+  }
+  EXPECT_NE(text.find("\nPeak resident memory: "), std::string::npos) << text;
+}
+
 // A T group of views 160 px wide of sparse hair, with its truth, in `dir` (a few seconds);
 // returns its dense workspace.
 std::string SynthesizeSmallSet(const std::string& dir) {
   const CommandOutput output =
       RunHairmvs("synthesize --output_path " + dir + " --width 160 --num_strands 20000");
   EXPECT_EQ(output.exit_code, 0) << output.text;
+  ExpectRunSummary(output.text, {"hair", "render", "write"});
   return JoinPaths(dir, "dense");
 }
 
@@ -110,6 +119,13 @@ TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
   ASSERT_TRUE(ExistsFile(summary)) << output.text;
   EXPECT_NE(ReadTextFile(summary).find("\"depth_type\": \"photometric\""), std::string::npos);
   EXPECT_NE(output.text.find("overall"), std::string::npos) << output.text;
+  ExpectRunSummary(output.text, {"filter kernel", "cost volume", "evaluate_depth"});
+  // The evaluators on their own end the same way.
+  output = RunHairmvs("evaluate_depth --workspace_path " + workspace + " --ground_truth_path " +
+                      JoinPaths(dir, "gt") + " --depth_type photometric");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  ExpectRunSummary(output.text, {"true strands", "read maps and truth", "per-pixel errors",
+                                 "3D distances", "error pictures", "summary"});
   std::filesystem::remove_all(dir);
 }
 
