@@ -49,7 +49,8 @@ GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::strin
                                          << " dimensions");
   const size_t height = depth.shape[0];
   const size_t width = depth.shape[1];
-  RequireShape(label, {height, width}, path + ": label");
+  // Named against depth: either of the two may be the wrong one.
+  RequireShape(label, {height, width}, path + ": label (the shape of depth)");
   GroundTruthView view;
   view.depth = FloatMap(static_cast<int>(width), static_cast<int>(height), 1);
   view.depth.Data() = depth.ToVector<float>(path + ": depth");
