@@ -675,14 +675,6 @@ void ReadFile(const std::string& path,
   reader(in, path, r);
 }
 
-// Whether `dir` holds all three of cameras, images and points3D with the extension `ext`.
-bool HasModelFiles(const std::string& dir, const char* ext) {
-  for (const char* name : {"cameras", "images", "points3D"}) {
-    if (!ExistsFile(JoinPaths(dir, std::string(name) + ext))) return false;
-  }
-  return true;
-}
-
 // The files of cameras, images, points3D with extension `ext` that exist in `dir` (`present`)
 // or that do not (!`present`), in that order.
 std::vector<std::string> ModelFilesPresent(const std::string& dir, const char* ext,
@@ -693,6 +685,11 @@ std::vector<std::string> ModelFilesPresent(const std::string& dir, const char* e
     if (ExistsFile(JoinPaths(dir, file)) == present) names.push_back(file);
   }
   return names;
+}
+
+// Whether `dir` holds all three of cameras, images and points3D with the extension `ext`.
+bool HasModelFiles(const std::string& dir, const char* ext) {
+  return ModelFilesPresent(dir, ext, false).empty();
 }
 
 // "a", "a and b", "a, b and c".
