@@ -10,8 +10,9 @@
 // view_params, per view (20 floats): K_j A (9, row-major), the last row of A (3), K_j a (3),
 // a.z (1), K_ref C (3), 0.
 // view_dims, per view (4 ints): width and height of j's depth map, offset of the map in
-// depth_maps (2 ints: hm_plane_offset). A point is seen when X_j.z > 0 and its projection (SfM convention: pixel
-// (c, r) covers [c, c+1) x [r, r+1)) falls inside the map; j's surface on the ray is
+// depth_maps (2 ints: hm_plane_offset). A point is seen when X_j.z > 0 and its projection (SfM
+// convention: pixel (c, r) covers [c, c+1) x [r, r+1)) falls inside the map; j's surface on the
+// ray is
 // S = C + (X - C) * depth_j / X_j.z, projected back by K_ref.
 // ref_params (9 floats): K_ref^-1 (row-major).
 

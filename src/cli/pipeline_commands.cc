@@ -216,8 +216,9 @@ int RunPipeline(int argc, char** argv) {
   }
   if (HasStage(stages, "fusion") && image_names.empty()) {
     std::printf("  %s/fused.ply, %s/meshed-hair.ply   the fused points and the hair surface "
-                "(MeshLab; COLMAP's GUI shows fused.ply, with File > Import From, over sparse/)\n", w,
-                w);
+                "(MeshLab; COLMAP's GUI shows fused.ply, with File > Import From, over "
+                "sparse/)\n",
+                w, w);
   }
   return 0;
 }

@@ -360,10 +360,11 @@ std::string WriteFailingColmap(const std::string& dir, const std::string& name,
   return path;
 }
 
-// A workspace made from photos appears only once whole: colmap failing, stopped by Ctrl-C (it
-// and this process sent SIGINT, as a terminal sends it), or the masks failing after it leave neither the workspace nor the
-// hidden folder it was made in; a whole one is published with everything the undistorter and
-// the step before publishing wrote, and removes what a run a signal ended left.
+// A workspace made from photos appears only once whole: colmap failing, or not to be run,
+// stopped by Ctrl-C (it and this process sent SIGINT, as a terminal sends it), passing over a
+// photo, or the masks failing after it leave neither the workspace nor the hidden folder it was
+// made in; a whole one is published with everything the undistorter and the step before
+// publishing wrote, and removes what a run a signal ended left.
 TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_publish");
