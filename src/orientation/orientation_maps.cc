@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <sstream>
 
 #include "colmap_ext/mat_io.h"
@@ -16,15 +17,52 @@ namespace {
 
 constexpr char kNumLevelsOption[] = "OrientationField.num_levels";
 
-// "<bytes> bytes, crc32 <hex>" of the file at `path`.
-std::string Fingerprint(const std::string& path) {
-  const std::string bytes = ReadTextFile(path);
+// "<bytes> bytes, crc32 <hex>" of a file's bytes.
+std::string FingerprintOf(const std::string& bytes) {
   // crc32_z takes a size_t length (crc32's uInt would need the file fed in pieces).
   const uLong crc = crc32_z(crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(bytes.data()),
                             bytes.size());
   char hex[9];
   std::snprintf(hex, sizeof(hex), "%08lx", crc);
   return std::to_string(bytes.size()) + " bytes, crc32 " + hex;
+}
+
+std::string Fingerprint(const std::string& path) { return FingerprintOf(ReadTextFile(path)); }
+
+// The provenance file is the inputs' provenance, then one line per level written with it,
+// "level <k> <fingerprint>": so that levels another process replaced after this one wrote them
+// (two runs with other options on one workspace) are not taken for this provenance's.
+constexpr char kLevelPrefix[] = "level ";
+
+std::string LevelLine(int level, const std::string& fingerprint) {
+  return kLevelPrefix + std::to_string(level) + " " + fingerprint;
+}
+
+// Splits a provenance file into its inputs' lines and its level lines' fingerprints.
+void SplitProvenanceFile(const std::string& text, std::string* inputs,
+                         std::map<int, std::string>* level_fingerprints) {
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind(kLevelPrefix, 0) == 0) {
+      std::istringstream fields(line.substr(sizeof(kLevelPrefix) - 1));
+      int level = -1;
+      std::string fingerprint;
+      if (fields >> level && std::getline(fields >> std::ws, fingerprint)) {
+        (*level_fingerprints)[level] = fingerprint;
+      }
+    } else {
+      *inputs += line + "\n";
+    }
+  }
+}
+
+// Why the level at `path` is not the one its provenance recorded, or "" when it is.
+std::string LevelChanged(const std::string& path, const std::string& recorded,
+                         const std::string& actual) {
+  if (recorded == actual) return "";
+  return "its cached orientation fields changed after their provenance was written (" + path +
+         " is " + actual + ", the provenance says " + recorded +
+         "): another run wrote them meanwhile, or they were damaged";
 }
 
 }  // namespace
@@ -60,11 +98,14 @@ bool CachedOrientationFieldsHold(const Workspace& workspace, const std::string& 
   if (!ExistsFile(provenance_path)) {
     if (ExistsFile(workspace.OrientationMapPath(name, 0))) {
       *why_not = "its cached orientation fields have no " + provenance_path +
-                 " (written by an older hairmvs, or their writing was interrupted)";
+                 " (written by an older hairmvs, being written by another run, or their "
+                 "writing was interrupted)";
     }
     return false;
   }
-  const std::string cached = ReadTextFile(provenance_path);
+  std::string cached;
+  std::map<int, std::string> level_fingerprints;
+  SplitProvenanceFile(ReadTextFile(provenance_path), &cached, &level_fingerprints);
   if (cached != provenance) {
     std::istringstream was(cached), now(provenance);
     std::string was_line, now_line;
@@ -104,6 +145,19 @@ bool CachedOrientationFieldsHold(const Workspace& workspace, const std::string& 
       *why_not = message.str();
       return false;
     }
+    const auto recorded = level_fingerprints.find(l);
+    if (recorded == level_fingerprints.end()) {
+      *why_not = "its cached orientation fields' " + provenance_path + " records no level " +
+                 std::to_string(l) + " (written by an older hairmvs)";
+      return false;
+    }
+    // The size alone here (the payload is read only when the fields are), its crc32 on reading.
+    const std::string recorded_bytes = recorded->second.substr(0, recorded->second.find(' '));
+    const std::string actual_bytes = std::to_string(std::filesystem::file_size(path));
+    if (recorded_bytes != actual_bytes) {
+      *why_not = LevelChanged(path, recorded->second, actual_bytes + " bytes");
+      return false;
+    }
   }
   return true;
 }
@@ -114,10 +168,25 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
   if (!CachedOrientationFieldsHold(workspace, name, provenance, camera, num_levels, why_not)) {
     return std::nullopt;
   }
+  std::string inputs;
+  std::map<int, std::string> level_fingerprints;
+  SplitProvenanceFile(ReadTextFile(workspace.OrientationMapProvenancePath(name)), &inputs,
+                      &level_fingerprints);
   std::vector<FloatMap> levels;
   for (int l = 0; l < num_levels; ++l) {
+    const std::string path = workspace.OrientationMapPath(name, l);
     try {
-      levels.push_back(ReadMat(workspace.OrientationMapPath(name, l)));
+      // The bytes read are those the provenance recorded: not another run's, written since.
+      const std::string bytes = ReadTextFile(path);
+      *why_not = LevelChanged(path, level_fingerprints[l], FingerprintOf(bytes));
+      if (!why_not->empty() || inputs != provenance) {
+        if (why_not->empty()) {
+          *why_not = "its cached orientation fields' provenance changed while they were read";
+        }
+        return std::nullopt;
+      }
+      std::istringstream in(bytes);
+      levels.push_back(ReadMat(in, path));
     } catch (const Error& e) {  // changed since the check (another process writing it)
       *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
       return std::nullopt;
@@ -132,10 +201,20 @@ void WriteOrientationFields(const Workspace& workspace, const std::string& name,
   std::error_code error;
   std::filesystem::remove(provenance_path, error);
   THROW_IF(error, "Cannot remove " << provenance_path << ": " << error.message());
+  // Each level's fingerprint is of the bytes this run wrote, not of the file after it (which
+  // another run may have replaced already).
+  std::string recorded = provenance;
   for (size_t l = 0; l < levels.size(); ++l) {
-    WriteMat(workspace.OrientationMapPath(name, static_cast<int>(l)), levels[l]);
+    std::ostringstream bytes;
+    WriteMat(bytes, levels[l]);
+    const std::string data = bytes.str();
+    WriteFileAtomically(workspace.OrientationMapPath(name, static_cast<int>(l)),
+                        [&data](std::ostream& out) {
+                          out.write(data.data(), static_cast<std::streamsize>(data.size()));
+                        });
+    recorded += LevelLine(static_cast<int>(l), FingerprintOf(data)) + "\n";
   }
-  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << provenance; },
+  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << recorded; },
                       /*binary=*/false);
 }
 

@@ -216,8 +216,32 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   OrientationFieldComputer computer(OpenCLContext::Create(), OrientationFieldOptions());
   WriteOrientationFields(workspace, "a.png", provenance,
                          computer.Compute(ReadImageGray(workspace.ImagePath("a.png")), FloatMap()));
-  EXPECT_EQ(ReadTextFile(workspace.OrientationMapProvenancePath("a.png")), provenance);
+  const std::string provenance_path = workspace.OrientationMapProvenancePath("a.png");
+  const std::string written = ReadTextFile(provenance_path);
+  EXPECT_EQ(written.rfind(provenance, 0), 0u) << written;
+  EXPECT_NE(written.find("\nlevel 2 "), std::string::npos) << written;
   EXPECT_TRUE(read("a.png", OrientationFieldOptions(), &why_not).has_value()) << why_not;
+  // A level that another run replaced after this provenance was written (the same size: the
+  // payload tells) is not taken for this provenance's, nor is a provenance of an older hairmvs
+  // that records no levels.
+  const std::string level0 = workspace.OrientationMapPath("a.png", 0);
+  const std::string level0_bytes = ReadTextFile(level0);
+  OrientationFieldOptions other_filter;
+  other_filter.sigma_along_px = 3;
+  WriteMat(level0, OrientationFieldComputer(OpenCLContext::Create(), other_filter)
+                       .Compute(ReadImageGray(workspace.ImagePath("a.png")), FloatMap())[0]);
+  ASSERT_NE(ReadTextFile(level0), level0_bytes);
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("changed after their provenance was written (" + level0 + " is "),
+            std::string::npos)
+      << why_not;
+  WriteFileAtomically(level0, [&](std::ostream& out) { out << level0_bytes; });
+  EXPECT_TRUE(read("a.png", OrientationFieldOptions(), &why_not).has_value()) << why_not;
+  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << provenance; }, false);
+  EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
+  EXPECT_NE(why_not.find("records no level 0 (written by an older hairmvs)"), std::string::npos)
+      << why_not;
+  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << written; }, false);
   std::filesystem::resize_file(workspace.OrientationMapPath("a.png", 1), 100);
   EXPECT_FALSE(read("a.png", OrientationFieldOptions(), &why_not).has_value());
   EXPECT_NE(why_not.find("cannot be read"), std::string::npos) << why_not;

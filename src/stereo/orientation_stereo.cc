@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <list>
 #include <map>
 #include <memory>
@@ -417,6 +418,13 @@ void WriteDepthAndNormals(const Workspace& workspace, const std::string& name,
   if (png) {
     WriteDepthPng(depth_path + ".png", depth);
     WriteNormalPng(normal_path + ".png", normals);
+  } else {
+    // A picture of the map this one replaced (an earlier run's --write_png 1) would show other
+    // depths: removed rather than left beside the new map.
+    for (const std::string& picture : {depth_path + ".png", normal_path + ".png"}) {
+      std::error_code ignored;
+      std::filesystem::remove(picture, ignored);
+    }
   }
 }
 

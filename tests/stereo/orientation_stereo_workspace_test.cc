@@ -194,6 +194,16 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   EXPECT_TRUE(ExistsFile(workspace.OrientationMapPath("v1.png", 0)));
   // Its sources have no depth maps yet: the .geometric map is the estimate, unfiltered.
   EXPECT_EQ(depth.Data(), ReadMat(workspace.DepthMapPath("v0.png", "photometric")).Data());
+  // Its pictures were written; a run without them replaces the maps and removes the pictures,
+  // which would show the old depths.
+  const std::string picture = workspace.DepthMapPath("v0.png") + ".png";
+  const std::string normal_picture = workspace.NormalMapPath("v0.png") + ".png";
+  EXPECT_TRUE(ExistsFile(picture));
+  options.write_png = false;
+  options.write_cost_volume = false;
+  RunOrientationStereo(path, {"v0.png"}, options, nullptr);
+  EXPECT_FALSE(ExistsFile(picture));
+  EXPECT_FALSE(ExistsFile(normal_picture));
   std::filesystem::remove_all(path);
 }
 
