@@ -168,29 +168,28 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
   if (!CachedOrientationFieldsHold(workspace, name, provenance, camera, num_levels, why_not)) {
     return std::nullopt;
   }
-  std::string inputs;
-  std::map<int, std::string> level_fingerprints;
-  SplitProvenanceFile(ReadTextFile(workspace.OrientationMapProvenancePath(name)), &inputs,
-                      &level_fingerprints);
   std::vector<FloatMap> levels;
-  for (int l = 0; l < num_levels; ++l) {
-    const std::string path = workspace.OrientationMapPath(name, l);
-    try {
+  try {  // the files may change from the check on (another run writing them)
+    std::string inputs;
+    std::map<int, std::string> level_fingerprints;
+    SplitProvenanceFile(ReadTextFile(workspace.OrientationMapProvenancePath(name)), &inputs,
+                        &level_fingerprints);
+    if (inputs != provenance) {
+      *why_not = "its cached orientation fields' provenance changed while they were read";
+      return std::nullopt;
+    }
+    for (int l = 0; l < num_levels; ++l) {
+      const std::string path = workspace.OrientationMapPath(name, l);
       // The bytes read are those the provenance recorded: not another run's, written since.
       const std::string bytes = ReadTextFile(path);
       *why_not = LevelChanged(path, level_fingerprints[l], FingerprintOf(bytes));
-      if (!why_not->empty() || inputs != provenance) {
-        if (why_not->empty()) {
-          *why_not = "its cached orientation fields' provenance changed while they were read";
-        }
-        return std::nullopt;
-      }
+      if (!why_not->empty()) return std::nullopt;
       std::istringstream in(bytes);
       levels.push_back(ReadMat(in, path));
-    } catch (const Error& e) {  // changed since the check (another process writing it)
-      *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
-      return std::nullopt;
     }
+  } catch (const Error& e) {
+    *why_not = std::string("its cached orientation fields cannot be read: ") + e.what();
+    return std::nullopt;
   }
   return levels;
 }
