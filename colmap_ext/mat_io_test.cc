@@ -108,9 +108,7 @@ TEST(MatIo, FailedDepthsLeaveTheOldCostVolume) {
 }
 
 TEST(MatIo, CostVolumeRoundTripAndBadDepths) {
-  const std::string dir =
-      (std::filesystem::temp_directory_path() / "hairmvs_cost_volume_io_test").string();
-  std::filesystem::remove_all(dir);
+  const std::string dir = testing_util::MakeTestDir("cost_volume_io");
   CostVolume volume;
   volume.cost = FloatMap(4, 3, 200);  // more labels than image channels ever have
   for (size_t i = 0; i < volume.cost.Data().size(); ++i) volume.cost.Data()[i] = 0.25f * i;

@@ -1,7 +1,7 @@
 #pragma once
 // Test helpers (header-only, used by colmap_ext's tests and tests/colmap_interop): a small
-// synthetic sparse model of PINHOLE cameras looking at a plane, temporary folders, comparisons;
-// with src/core/test_util.h's ErrorOf.
+// synthetic sparse model of PINHOLE cameras looking at a plane, comparisons; with
+// src/core/test_util.h's ErrorOf and MakeTestDir.
 
 #include <gtest/gtest.h>
 
@@ -14,18 +14,10 @@
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
-#include "src/core/test_util.h"  // ErrorOf
+#include "src/core/test_util.h"  // ErrorOf, MakeTestDir
 
 namespace hairmvs {
 namespace testing_util {
-
-// A fresh, empty folder under the test temp dir.
-inline std::string MakeTestDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_colmap_ext_" + name);
-  std::filesystem::remove_all(dir);
-  CreateDirs(dir);
-  return dir;
-}
 
 struct PlaneModelOptions {
   int width = 64;

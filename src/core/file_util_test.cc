@@ -15,15 +15,10 @@
 namespace hairmvs {
 namespace {
 
-std::string TestDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_core_" + name);
-  std::filesystem::remove_all(dir);
-  CreateDirs(dir);
-  return dir;
-}
+using testing_util::MakeTestDir;
 
 TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
-  const std::string dir = TestDir("atomic");
+  const std::string dir = MakeTestDir("atomic");
   const std::string path = JoinPaths(dir, "sub", "file.txt");
   WriteFileAtomically(path, [](std::ostream& out) { out << "first"; });
   EXPECT_EQ(ReadTextFile(path), "first");
@@ -42,7 +37,7 @@ TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
 // dies of the signal, and both temporaries are gone while the old target is whole. Each case
 // runs in a child process (a death test), so the handlers do not stay installed here.
 TEST(FileUtil, InterruptRemovesTemporariesInFlight) {
-  const std::string dir = TestDir("interrupt");
+  const std::string dir = MakeTestDir("interrupt");
   const std::string kept = JoinPaths(dir, "kept.txt");
   const std::string named = JoinPaths(dir, "named.png");
   WriteFileAtomically(kept, [](std::ostream& out) { out << "old"; });
@@ -83,7 +78,7 @@ TEST(FileUtil, InterruptHandlersLeaveIgnoredSignalsIgnored) {
 // Past `ulimit -f` a write fails with a message and leaves the old file, rather than SIGXFSZ
 // ending the process with its temporary left.
 TEST(FileUtil, FileSizeLimitFailsTheWriteNotTheProcess) {
-  const std::string dir = TestDir("size_limit");
+  const std::string dir = MakeTestDir("size_limit");
   const std::string kept = JoinPaths(dir, "kept.txt");
   WriteFileAtomically(kept, [](std::ostream& out) { out << "old"; });
   EXPECT_EXIT(
@@ -108,7 +103,7 @@ TEST(FileUtil, FileSizeLimitFailsTheWriteNotTheProcess) {
 // Files written as a unit: a writer that throws after another's temporary is complete leaves
 // every old target byte for byte and no temporary; once all writers succeed, all are replaced.
 TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
-  const std::string dir = TestDir("unit");
+  const std::string dir = MakeTestDir("unit");
   const std::string first = JoinPaths(dir, "cameras.bin");
   const std::string second = JoinPaths(dir, "images.bin");
   const std::string old_first("old\0cameras", 11), old_second = "old images\n";
@@ -150,7 +145,7 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
 // Copies as a unit (undistort_masks' masks): all are copied, empty files too, or, when a
 // source cannot be read, none, the source named.
 TEST(FileUtil, CopyFilesAtomicallyCopiesAllOrNone) {
-  const std::string dir = TestDir("copy_unit");
+  const std::string dir = MakeTestDir("copy_unit");
   const std::string a = JoinPaths(dir, "a.png"), empty = JoinPaths(dir, "empty.png");
   WriteFileAtomically(a, [](std::ostream& out) { out << std::string("\x89PNG\0x", 6); });
   WriteFileAtomically(empty, [](std::ostream&) {});
@@ -170,7 +165,7 @@ TEST(FileUtil, CopyFilesAtomicallyCopiesAllOrNone) {
 
 // A write that cannot start or cannot be renamed into place says why, and leaves no temporary.
 TEST(FileUtil, FailedWriteSaysWhy) {
-  const std::string dir = TestDir("failed_write");
+  const std::string dir = MakeTestDir("failed_write");
   auto write = [](std::ostream& out) { out << "data"; };
   // The temporary's name (".<name>.tmp<pid>_<n>.txt") is over the file system's 255 bytes.
   const std::string long_path = JoinPaths(dir, std::string(250, 'a') + ".txt");
@@ -190,7 +185,7 @@ TEST(FileUtil, FailedWriteSaysWhy) {
 
 // A folder this process may not write to is named before any work; a missing one is made.
 TEST(FileUtil, RequireWritableDir) {
-  const std::string dir = JoinPaths(TestDir("writable"), "stereo", "depth_maps");
+  const std::string dir = JoinPaths(MakeTestDir("writable"), "stereo", "depth_maps");
   RequireWritableDir(dir, "depth map folder");
   EXPECT_TRUE(ExistsDir(dir));
   // procfs refuses writes to a process's folder even to root (the tests may run as root, to
@@ -213,7 +208,7 @@ TEST(FileUtil, MissingFileErrorNamesThePath) {
 
 // A folder where a file is expected, or the other way round, is named as such, not as missing.
 TEST(FileUtil, FileWhereAFolderIsExpectedIsNamed) {
-  const std::string dir = TestDir("kinds");
+  const std::string dir = MakeTestDir("kinds");
   const std::string file = JoinPaths(dir, "fused.ply");
   WriteFileAtomically(file, [](std::ostream& out) { out << "ply"; });
   EXPECT_EQ(testing_util::ErrorOf([&] { RequireDir(file, "workspace folder"); }),

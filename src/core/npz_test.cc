@@ -7,16 +7,12 @@
 #include <fstream>
 
 #include "src/core/file_util.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
 
-std::string TestDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_npz_" + name);
-  std::filesystem::remove_all(dir);
-  CreateDirs(dir);
-  return dir;
-}
+using testing_util::MakeTestDir;
 
 void WriteBytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -46,7 +42,7 @@ std::string ExpectThrowMessage(const std::function<void()>& f) {
 }
 
 TEST(Npz, NpyRoundTripAllTypes) {
-  const std::string dir = TestDir("npy");
+  const std::string dir = MakeTestDir("npy");
   const auto f4 = NpyArray::FromVector<float>({1.5f, -2.f, 3.25f, 0.f, 7.f, 8.f}, {2, 3});
   WriteNpy(JoinPaths(dir, "a.npy"), f4);
   const NpyArray back = ReadNpy(JoinPaths(dir, "a.npy"));
@@ -92,7 +88,7 @@ TEST(Npz, NpyRoundTripAllTypes) {
 }
 
 TEST(Npz, NpzRoundTripDeflateAndStored) {
-  const std::string dir = TestDir("npz");
+  const std::string dir = MakeTestDir("npz");
   std::vector<float> depth(40 * 30);
   for (size_t i = 0; i < depth.size(); ++i) depth[i] = 0.5f + 0.001f * (i % 17);
   std::map<std::string, NpyArray> arrays;
@@ -120,7 +116,7 @@ TEST(Npz, NpzRoundTripDeflateAndStored) {
 }
 
 TEST(Npz, ErrorsNameTheFile) {
-  const std::string dir = TestDir("errors");
+  const std::string dir = MakeTestDir("errors");
   const std::string missing = JoinPaths(dir, "missing.npz");
   EXPECT_NE(ExpectThrowMessage([&] { ReadNpz(missing); }).find("missing.npz"), std::string::npos);
 

@@ -15,6 +15,16 @@
 namespace hairmvs {
 namespace testing_util {
 
+// A fresh, empty folder hairmvs_<name> under the system's temporary folder: the tests' one way
+// to make one. A test's next run replaces it, so runs leave one copy at most; two suites run at
+// once (from two checkouts) share the names, and must not.
+inline std::string MakeTestDir(const std::string& name) {
+  const std::string dir = (std::filesystem::temp_directory_path() / ("hairmvs_" + name)).string();
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
 // The message of the hairmvs::Error that f() throws; "(no error)" when it throws none.
 template <typename F>
 std::string ErrorOf(F&& f) {

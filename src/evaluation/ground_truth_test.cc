@@ -17,12 +17,7 @@
 namespace hairmvs {
 namespace {
 
-std::string TestDir(const std::string& name) {
-  const std::string dir = JoinPaths(::testing::TempDir(), "hairmvs_gt_" + name);
-  std::filesystem::remove_all(dir);
-  CreateDirs(dir);
-  return dir;
-}
+using testing_util::MakeTestDir;
 
 // Curved strands with points ~6 mm apart, like the shared sets.
 GroundTruthStrands TestStrands() {
@@ -110,7 +105,7 @@ TEST(GroundTruth, MissingFolderIsNamedAsTheGroundTruth) {
 }
 
 TEST(GroundTruth, FilesRoundTrip) {
-  const std::string dir = TestDir("files");
+  const std::string dir = MakeTestDir("files");
   GroundTruthView view;
   view.depth = FloatMap(5, 4, 1, 0.0f);
   view.label.assign(20, kLabelBackground);

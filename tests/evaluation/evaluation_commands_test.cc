@@ -37,8 +37,7 @@ struct Scene {
 
 Scene MakeScene(const std::string& name) {
   Scene scene;
-  scene.dir = JoinPaths(::testing::TempDir(), "hairmvs_eval_" + name);
-  std::filesystem::remove_all(scene.dir);
+  scene.dir = testing_util::MakeTestDir("eval_" + name);
   scene.gt = JoinPaths(scene.dir, "gt");
   scene.workspace = JoinPaths(scene.dir, "dense");
   GroundTruthCameras& cameras = scene.cameras;

@@ -13,6 +13,7 @@
 #include "src/core/timer.h"
 #include "src/evaluation/depth_evaluation.h"
 #include "src/evaluation/ground_truth.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
@@ -64,8 +65,7 @@ TEST(GroundTruthData, GantrySelfCheckAndMedianFilteredTruth) {
   // 2. The README's figures for the true depth maps median-filtered 7 x 7 (all 32 views:
   // per-pixel mean 5.5 mm, median 2.2 mm, 3D median 0.33 mm), on two views: the front
   // (g1_c) and the side (g5_c), whose stray silhouette strands give larger means.
-  const std::string out = JoinPaths(::testing::TempDir(), "hairmvs_eval_median7");
-  std::filesystem::remove_all(out);
+  const std::string out = testing_util::MakeTestDir("eval_median7");
   ImportGroundTruthOptions import_options;
   import_options.median_filter_px = 7;
   import_options.image_names = {"g1_c.png", "g5_c.png"};

@@ -21,17 +21,12 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/fusion/fusion_test_scenes.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
 
-std::string MakeTempDir(const std::string& name) {
-  const std::string dir = JoinPaths(std::filesystem::temp_directory_path().string(),
-                                    "hairmvs_fusion_" + name + "_" + std::to_string(getpid()));
-  std::filesystem::remove_all(dir);
-  CreateDirs(dir);
-  return dir;
-}
+using testing_util::MakeTestDir;
 
 // Writes views as a COLMAP dense workspace; image ids are assigned in reverse so that the
 // image_idx order (file order, ascending ids as we write) differs from the views' order.
@@ -88,7 +83,7 @@ TemplateFusionOptions EveryPixelOneThread() {
 }
 
 TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
-  const std::string dir = MakeTempDir("torus");
+  const std::string dir = MakeTestDir("torus");
   testing::SceneOptions scene = TorusViews();
   scene.depth_noise = 0.003;
   const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
@@ -164,7 +159,7 @@ TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
 // Depth maps without normal maps (another tool's, or normal maps deleted to save space):
 // the normals of the fused points come from the depth maps, and the log says so per view.
 TEST(FusionWorkspace, NormalsFromTheDepthMapsWhereNormalMapsAreMissing) {
-  const std::string dir = MakeTempDir("no_normals");
+  const std::string dir = MakeTestDir("no_normals");
   const testing::Sdf sdf = testing::TorusSdf(1.0, 0.4);
   WriteWorkspace(testing::RenderViews(sdf, TorusViews()), dir);
   std::filesystem::remove_all(JoinPaths(dir, "stereo", "normal_maps"));
@@ -195,7 +190,7 @@ TEST(FusionWorkspace, NormalsFromTheDepthMapsWhereNormalMapsAreMissing) {
 }
 
 TEST(FusionWorkspace, NoDepthMapsIsAnErrorNamingTheFolder) {
-  const std::string dir = MakeTempDir("empty");
+  const std::string dir = MakeTestDir("empty");
   testing::SceneOptions scene;
   scene.width = 16;
   scene.height = 12;
@@ -217,7 +212,7 @@ TEST(FusionWorkspace, NoDepthMapsIsAnErrorNamingTheFolder) {
 // naming it, not a camera stretched one way; views without a .geometric map among views with
 // one are fused from their first estimate, and the log names them.
 TEST(FusionWorkspace, DepthMapsThatDoNotFitTheirViewAreNamed) {
-  const std::string dir = MakeTempDir("misfit");
+  const std::string dir = MakeTestDir("misfit");
   WriteWorkspace(testing::RenderViews(testing::TorusSdf(1.0, 0.4), TorusViews()), dir);
   const Workspace workspace = Workspace::Read(dir);
   const std::string first = workspace.ImageNames()[0], second = workspace.ImageNames()[1];

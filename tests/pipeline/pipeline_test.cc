@@ -20,13 +20,13 @@
 #include "src/core/file_util.h"
 #include "src/evaluation/depth_evaluation.h"
 #include "src/evaluation/ground_truth.h"
+#include "src/core/test_util.h"
 
 namespace hairmvs {
 namespace {
 
 TEST(Pipeline, SynthesizedSetEndToEnd) {
-  const std::string root = JoinPaths(::testing::TempDir(), "hairmvs_pipeline_test");
-  std::filesystem::remove_all(root);
+  const std::string root = testing_util::MakeTestDir("pipeline_test");
 
   SynthesizeOptions synth;
   synth.output_path = root;

@@ -18,11 +18,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("hairmvs_synthesize_test_" + name);
-  fs::remove_all(dir);
-  return dir.string();
-}
+using testing_util::MakeTestDir;
 
 SynthesizeOptions SmallOptions(const std::string& path) {
   SynthesizeOptions options;
@@ -64,7 +60,7 @@ TEST(Synthesize, OptionsAreChecked) {
 }
 
 TEST(Synthesize, GantryWorkspaceReadsBackWithGroundTruth) {
-  const std::string path = TempDir("gantry");
+  const std::string path = MakeTestDir("gantry");
   const SynthesizeResult result = RunSynthesize(SmallOptions(path));
   EXPECT_EQ(result.num_views, 4);
   EXPECT_EQ(result.width, 160);
@@ -154,10 +150,10 @@ TEST(Synthesize, GantryWorkspaceReadsBackWithGroundTruth) {
 // strands in gt/, the same cameras and true depths and labels; only the strands' colours
 // differ (they are not stored).
 TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
-  const std::string first_path = TempDir("strands_first");
+  const std::string first_path = MakeTestDir("strands_first");
   RunSynthesize(SmallOptions(first_path));
   const std::string gt_first = JoinPaths(first_path, "gt");
-  const std::string second_path = TempDir("strands_second");
+  const std::string second_path = MakeTestDir("strands_second");
   SynthesizeOptions options = SmallOptions(second_path);
   options.strands_path = gt_first;
   options.num_strands = 7;  // not used with strands_path
@@ -186,14 +182,14 @@ TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
             ReadBytes(JoinPaths(second_path, "dense", "images", "g0_c.png")));
 
   options.strands_path = JoinPaths(first_path, "no_such_folder");
-  options.output_path = TempDir("strands_third");
+  options.output_path = MakeTestDir("strands_third");
   const std::string message = testing_util::ErrorOf([&] { RunSynthesize(options); });
   EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
   EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
 }
 
 TEST(Synthesize, DeterministicForASeed) {
-  const std::string a = TempDir("det_a"), b = TempDir("det_b"), c = TempDir("det_c");
+  const std::string a = MakeTestDir("det_a"), b = MakeTestDir("det_b"), c = MakeTestDir("det_c");
   SynthesizeOptions options = SmallOptions(a);
   options.style = HairStyle::kCurly;
   options.rig = CameraRigType::kHandheld;
