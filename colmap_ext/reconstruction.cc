@@ -694,12 +694,9 @@ bool HasModelFiles(const std::string& dir, const char* ext) {
 
 // "a", "a and b", "a, b and c".
 std::string JoinWithAnd(const std::vector<std::string>& items) {
-  std::string joined;
-  for (size_t i = 0; i < items.size(); ++i) {
-    if (i > 0) joined += i + 1 == items.size() ? " and " : ", ";
-    joined += items[i];
-  }
-  return joined;
+  if (items.size() < 2) return JoinStrings(items, "");
+  const std::vector<std::string> all_but_last(items.begin(), items.end() - 1);
+  return JoinStrings(all_but_last, ", ") + " and " + items.back();
 }
 
 }  // namespace

@@ -81,12 +81,13 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   Timer timer;
   const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
   LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
             << timer.ElapsedSeconds() << " s)";
-  if (timings != nullptr) timings->Add("true strands", timer.ElapsedSeconds());
+  laps.Lap("true strands");
   return EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, strand_distance,
                       timings);
 }
