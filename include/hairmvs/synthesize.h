@@ -93,8 +93,10 @@ struct SynthesizeResult {
   std::string BriefReport() const;
 };
 
-// Generates the data set under options.output_path (folders created; files written
-// atomically). Throws hairmvs::Error for invalid options or unwritable paths.
+// Generates the data set under options.output_path: dense/, gt/ and sparse/ (a text copy of
+// the model), refused if any exists there already. They are written into a hidden folder of
+// output_path and moved into place together once complete, so a run that throws leaves none of
+// them. Throws hairmvs::Error for invalid options or unwritable paths.
 SynthesizeResult RunSynthesize(const SynthesizeOptions& options);
 
 }  // namespace hairmvs

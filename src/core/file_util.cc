@@ -247,6 +247,41 @@ void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>&
   WriteFilesAtomically(files);
 }
 
+StagingDir::StagingDir(const std::string& parent, const std::string& name)
+    : parent_(parent), path_(TemporaryPathFor(JoinPaths(parent, name))) {
+  CreateDirs(path_);
+}
+
+StagingDir::~StagingDir() {
+  if (committed_) return;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
+void StagingDir::Commit(const std::vector<std::string>& entries) {
+  THROW_IF(committed_, "StagingDir " << path_ << " was committed already");
+  for (const std::string& entry : entries) {
+    const std::string from = JoinPaths(path_, entry);
+    const std::string to = JoinPaths(parent_, entry);
+    std::error_code ec;
+    THROW_IF(!fs::exists(fs::symlink_status(from, ec)),
+             "Cannot move " << from << " into place: it was not written");
+    THROW_IF(fs::exists(fs::symlink_status(to, ec)),
+             "Cannot move " << from << " to " << to << ": " << to
+                            << " exists already (written by another process meanwhile?)");
+  }
+  for (const std::string& entry : entries) {
+    const std::string from = JoinPaths(path_, entry);
+    const std::string to = JoinPaths(parent_, entry);
+    std::error_code ec;
+    fs::rename(from, to, ec);
+    THROW_IF(ec, "Cannot rename " << from << " to " << to << ": " << ec.message());
+  }
+  committed_ = true;
+  std::error_code ec;
+  fs::remove_all(path_, ec);
+}
+
 void RemoveTemporaryFilesOnInterrupt() {
   for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
     struct sigaction previous {};

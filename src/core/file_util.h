@@ -62,6 +62,32 @@ void CopyFileAtomically(const std::string& from, const std::string& to);
 // Each pair's `from` copied to its `to` as one unit (WriteFilesAtomically).
 void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>& from_to);
 
+// A hidden folder `.<name>.tmp<pid>_<n>` inside `parent` (created, with `parent`), in which an
+// output that is only valid as a whole (a synthesized data set: images, masks, model and truth)
+// is built: Commit() renames its named entries into `parent`, where none of them may exist yet;
+// destroyed uncommitted (the work threw), it is removed with everything in it, so a failed run
+// leaves nothing that the next one would have to refuse or overwrite. A process killed outright
+// leaves it, hidden, beside the outputs it never replaced.
+class StagingDir {
+ public:
+  StagingDir(const std::string& parent, const std::string& name);
+  ~StagingDir();
+  StagingDir(const StagingDir&) = delete;
+  StagingDir& operator=(const StagingDir&) = delete;
+
+  // The folder to write into.
+  const std::string& Path() const { return path_; }
+  // Moves each of `entries` (names inside Path()) to `parent`/<entry>, in order, then removes
+  // Path(). Throws hairmvs::Error naming the entry when one is missing here or exists already
+  // in `parent` (checked for all before any is moved), or when a rename fails.
+  void Commit(const std::vector<std::string>& entries);
+
+ private:
+  std::string parent_;
+  std::string path_;
+  bool committed_ = false;
+};
+
 // Installs handlers for SIGINT, SIGTERM and SIGHUP (those not ignored) that remove the
 // temporary files of the writes above still in flight, then let the signal end the process as
 // it would have: a run stopped with Ctrl-C or by a cluster scheduler leaves no hidden

@@ -184,6 +184,45 @@ TEST(FileUtil, FailedWriteSaysWhy) {
 }
 
 // A folder this process may not write to is named before any work; a missing one is made.
+// A staged output appears in its folder whole or not at all.
+TEST(FileUtil, StagingDirMovesEntriesIntoPlaceOrRemovesThem) {
+  const std::string dir = MakeTestDir("staging");
+  {
+    StagingDir staging(dir, "set");
+    WriteFileAtomically(JoinPaths(staging.Path(), "dense", "a.txt"),
+                        [](std::ostream& out) { out << "a"; });
+    WriteFileAtomically(JoinPaths(staging.Path(), "gt.txt"), [](std::ostream& out) { out << "b"; });
+    EXPECT_EQ(testing_util::NumEntriesIn(dir), 1);  // only the hidden staging folder
+    staging.Commit({"dense", "gt.txt"});
+  }
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "dense", "a.txt")), "a");
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "gt.txt")), "b");
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);
+
+  // Work that throws before the commit leaves nothing behind.
+  EXPECT_THROW(
+      {
+        StagingDir staging(dir, "set");
+        WriteFileAtomically(JoinPaths(staging.Path(), "other.txt"),
+                            [](std::ostream& out) { out << "c"; });
+        throw std::runtime_error("rendering failed");
+      },
+      std::runtime_error);
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);
+
+  // An entry that exists in the folder already is named, and nothing is moved.
+  StagingDir staging(dir, "set");
+  WriteFileAtomically(JoinPaths(staging.Path(), "new.txt"), [](std::ostream& out) { out << "n"; });
+  WriteFileAtomically(JoinPaths(staging.Path(), "gt.txt"), [](std::ostream& out) { out << "x"; });
+  const std::string exists = testing_util::ErrorOf([&] { staging.Commit({"new.txt", "gt.txt"}); });
+  EXPECT_NE(exists.find(JoinPaths(dir, "gt.txt") + " exists already"), std::string::npos)
+      << exists;
+  EXPECT_FALSE(ExistsFile(JoinPaths(dir, "new.txt")));
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "gt.txt")), "b");
+  const std::string missing = testing_util::ErrorOf([&] { staging.Commit({"sparse"}); });
+  EXPECT_NE(missing.find("sparse into place: it was not written"), std::string::npos) << missing;
+}
+
 TEST(FileUtil, RequireWritableDir) {
   const std::string dir = JoinPaths(MakeTestDir("writable"), "stereo", "depth_maps");
   RequireWritableDir(dir, "depth map folder");

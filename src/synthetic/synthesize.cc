@@ -140,12 +140,17 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   SynthesizeResult result;
   // A set written over another would keep the old one's depth maps, fusion and truth beside the
   // new images; named before minutes of rendering.
-  for (const char* part : {"dense", "gt"}) {
+  const std::vector<std::string> parts = {"dense", "gt", "sparse"};
+  for (const std::string& part : parts) {
     const std::string path = JoinPaths(options.output_path, part);
     THROW_IF(ExistsFile(path) || ExistsDir(path),
              "synthesize: " << path << " exists already: give a new --output_path (or remove "
                             << "the old set first)");
   }
+  // The set is written into a hidden folder of output_path and its parts moved into place once
+  // all are written: a run that fails (a full disk, a bad strands file) leaves no half set that
+  // the next run would refuse.
+  StagingDir staging(options.output_path, "synthesize");
 
   // Hair.
   Timer timer;
@@ -184,8 +189,8 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   result.width = W;
   result.height = H;
 
-  const std::string dense_path = JoinPaths(options.output_path, "dense");
-  const std::string gt_path = JoinPaths(options.output_path, "gt");
+  const std::string dense_path = JoinPaths(staging.Path(), "dense");
+  const std::string gt_path = JoinPaths(staging.Path(), "gt");
   for (const char* sub : {"images", "masks", "sparse", "stereo/depth_maps",
                           "stereo/normal_maps"}) {
     CreateDirs(JoinPaths(dense_path, sub));
@@ -245,7 +250,7 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   result.mean_track_length =
       model.points3D.empty() ? 0.0 : static_cast<double>(track_sum) / model.points3D.size();
   WriteReconstruction(model, JoinPaths(dense_path, "sparse"), ModelFormat::kBinary);
-  WriteReconstruction(model, JoinPaths(options.output_path, "sparse"), ModelFormat::kText);
+  WriteReconstruction(model, JoinPaths(staging.Path(), "sparse"), ModelFormat::kText);
 
   // stereo/*.cfg as colmap image_undistorter writes them.
   WriteFileAtomically(
@@ -311,6 +316,7 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   WriteFileAtomically(
       JoinPaths(gt_path, "meta.json"), [&](std::ostream& out) { out << meta.dump(1) << "\n"; },
       false);
+  staging.Commit(parts);
   result.seconds_write += timer.ElapsedSeconds();
   result.seconds_total = total_timer.ElapsedSeconds();
   return result;

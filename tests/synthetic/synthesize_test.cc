@@ -186,6 +186,12 @@ TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
   const std::string message = testing_util::ErrorOf([&] { RunSynthesize(options); });
   EXPECT_NE(message.find("ground truth folder"), std::string::npos) << message;
   EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
+  // The failed run leaves nothing (not even its hidden staging folder), so the same command
+  // with the right strands runs at once.
+  EXPECT_EQ(testing_util::NumEntriesIn(options.output_path), 0);
+  options.strands_path = gt_first;
+  RunSynthesize(options);
+  EXPECT_EQ(testing_util::NumEntriesIn(options.output_path), 3);  // dense, gt, sparse
 }
 
 TEST(Synthesize, DeterministicForASeed) {
