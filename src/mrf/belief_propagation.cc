@@ -105,7 +105,6 @@ std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int ite
       problem.weight_right.empty() ? zeros : problem.weight_right;
   const std::vector<float>& weight_down = problem.weight_down.empty() ? zeros : problem.weight_down;
 
-  cl::Context& ctx = context->Context();
   cl::CommandQueue& queue = context->Queue();
   const std::string options = "-D NUM_LABELS=" + std::to_string(num_labels);
   cl::Program& program = context->Program({"mrf_bp.cl"}, options);
@@ -116,8 +115,8 @@ std::vector<int> SolveBeliefPropagationOpenCL(const MrfProblem& problem, int ite
   cl::Buffer right_buffer = ReadOnlyBuffer(context, weight_right);
   cl::Buffer down_buffer = ReadOnlyBuffer(context, weight_down);
   const size_t msg_bytes = 4 * n * num_labels * sizeof(float);
-  cl::Buffer msg_buffer(ctx, CL_MEM_READ_WRITE, msg_bytes);
-  cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
+  cl::Buffer msg_buffer = context->Buffer(CL_MEM_READ_WRITE, msg_bytes);
+  cl::Buffer label_buffer = context->Buffer(CL_MEM_READ_WRITE, n * sizeof(int));
   queue.enqueueFillBuffer(msg_buffer, 0.0f, 0, msg_bytes);
 
   const cl::NDRange global = MrfGlobalRange(n);

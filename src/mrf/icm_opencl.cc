@@ -32,7 +32,7 @@ void RunIcmOpenCL(OpenCLContext* context, const cl::Buffer& cost, const cl::Buff
   cl::Program& program =
       context->Program({"mrf_icm.cl"}, "-D NUM_LABELS=" + std::to_string(problem.num_labels));
   cl::Kernel kernel(program, "icm_colour");
-  cl::Buffer changed_buffer(context->Context(), CL_MEM_READ_WRITE, sizeof(int));
+  cl::Buffer changed_buffer = context->Buffer(CL_MEM_READ_WRITE, sizeof(int));
   const cl::NDRange global = MrfGlobalRange(problem.NumPixels());
   SetCheckerboardKernelArgs(&kernel, cost, offset, weight_right, weight_down, problem);
   kernel.setArg(9, labels);

@@ -213,12 +213,11 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
       problem.label_offset.empty() ? std::vector<float>(n, 0.0f) : problem.label_offset;
   const SemiGlobalEdgeWeights weights = ComputeSemiGlobalEdgeWeights(problem);
 
-  cl::Context& ctx = context->Context();
   cl::CommandQueue& queue = context->Queue();
   cl::Program& program =
       context->Program({"mrf_sgm.cl"}, "-D NUM_LABELS=" + std::to_string(num_labels));
   cl::Buffer offset_buffer = ReadOnlyBuffer(context, offset);
-  cl::Buffer label_buffer(ctx, CL_MEM_READ_WRITE, n * sizeof(int));
+  cl::Buffer label_buffer = context->Buffer(CL_MEM_READ_WRITE, n * sizeof(int));
   // Each direction's weight buffer stays alive until the queue has finished with it; [0] and
   // [2], directions (1, 0) and (0, 1), are weights.right and .down, which ICM reads too.
   std::vector<cl::Buffer> weight_buffers;
@@ -227,7 +226,8 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
     // pixel-major on the device, the costs written transposed straight into the mapped buffer
     // (no second host copy of the volume).
     const size_t volume_bytes = n * num_labels * sizeof(float);
-    cl::Buffer cost_buffer(ctx, CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, volume_bytes);
+    cl::Buffer cost_buffer =
+        context->Buffer(CL_MEM_READ_ONLY | CL_MEM_ALLOC_HOST_PTR, volume_bytes);
     float* cost_by_pixel = static_cast<float*>(queue.enqueueMapBuffer(
         cost_buffer, CL_TRUE, CL_MAP_WRITE_INVALIDATE_REGION, 0, volume_bytes));
     for (int b = 0; b < num_labels; ++b) {
@@ -235,7 +235,7 @@ std::vector<int> SolveSemiGlobalOpenCL(const MrfProblem& problem, int num_direct
       for (size_t p = 0; p < n; ++p) cost_by_pixel[p * num_labels + b] = slice[p];
     }
     queue.enqueueUnmapMemObject(cost_buffer, cost_by_pixel);
-    cl::Buffer sum_buffer(ctx, CL_MEM_READ_WRITE, volume_bytes);
+    cl::Buffer sum_buffer = context->Buffer(CL_MEM_READ_WRITE, volume_bytes);
     queue.enqueueFillBuffer(sum_buffer, 0.0f, 0, volume_bytes);
     cl::Kernel path_kernel(program, "sgm_path");
     cl::Kernel argmin_kernel(program, "sgm_argmin");

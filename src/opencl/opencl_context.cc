@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <iomanip>
 #include <set>
 #include <sstream>
 
@@ -120,6 +121,11 @@ void ResolveIncludesInText(const std::string& file, const std::string& text,
 
 }  // namespace
 
+// What to do when the device is out of memory: the end of both messages that say so.
+constexpr const char* kOpenCLOutOfMemoryAdvice =
+    "a smaller --OrientationStereo.max_image_size, or --OpenCL.device of another device "
+    "(`hairmvs opencl_devices` lists each device's memory and largest allocation)";
+
 std::string DescribeException(const std::exception& e) {
   const auto* error = dynamic_cast<const cl::Error*>(&e);
   if (error == nullptr) return e.what();
@@ -130,9 +136,8 @@ std::string DescribeException(const std::exception& e) {
     case CL_OUT_OF_RESOURCES:
     case CL_OUT_OF_HOST_MEMORY:
     case CL_INVALID_BUFFER_SIZE:
-      message << ": the device ran out of memory, or a buffer exceeds its largest allocation "
-                 "(`hairmvs opencl_devices` lists both); a smaller "
-                 "--OrientationStereo.max_image_size or --OpenCL.device of another device";
+      message << ": the device ran out of memory, or a buffer exceeds its largest allocation; "
+              << kOpenCLOutOfMemoryAdvice;
       break;
     default:
       break;
@@ -238,6 +243,7 @@ std::shared_ptr<OpenCLContext> OpenCLContext::Create(const std::string& device_s
   ctx->platform_name_ = StripWhitespace(platform.getInfo<CL_PLATFORM_NAME>());
   ctx->device_name_ = StripWhitespace(device.getInfo<CL_DEVICE_NAME>());
   ctx->is_cpu_ = (device.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) != 0;
+  ctx->max_alloc_bytes_ = static_cast<size_t>(device.getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>());
   try {
     ctx->context_ = cl::Context(device);
     ctx->queue_ = cl::CommandQueue(ctx->context_, device);  // in-order, no profiling
@@ -309,6 +315,16 @@ cl::Program& OpenCLContext::BuildProgram(const std::string& source,
   return programs_.emplace(key, std::move(program)).first->second;
 }
 
+cl::Buffer OpenCLContext::Buffer(cl_mem_flags flags, size_t bytes, void* host) const {
+  constexpr double kMiB = 1024.0 * 1024.0;
+  THROW_IF(bytes > max_alloc_bytes_,
+           "A buffer of " << std::fixed << std::setprecision(1) << bytes / kMiB << " MiB ("
+                          << bytes << " bytes) exceeds the largest allocation of OpenCL device '"
+                          << device_name_ << "', " << max_alloc_bytes_ / kMiB << " MiB; "
+                          << kOpenCLOutOfMemoryAdvice);
+  return cl::Buffer(context_, flags, bytes, host);
+}
+
 cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes) {
   // A buffer of 0 bytes is invalid: short data (an empty vector, whose data() may be null, or
   // a single byte) is copied from a zero-padded block of the minimum size, not read beyond.
@@ -316,11 +332,9 @@ cl::Buffer ReadOnlyBuffer(OpenCLContext* context, const void* data, size_t bytes
   if (bytes < kMinBytes) {
     unsigned char padded[kMinBytes] = {};
     if (bytes > 0) std::memcpy(padded, data, bytes);
-    return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kMinBytes,
-                      padded);
+    return context->Buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, kMinBytes, padded);
   }
-  return cl::Buffer(context->Context(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes,
-                    const_cast<void*>(data));
+  return context->Buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR, bytes, const_cast<void*>(data));
 }
 
 std::array<int, 4> ConcatenatedPlaneDims(int width, int height, size_t offset) {

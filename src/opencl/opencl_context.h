@@ -11,9 +11,10 @@
 //  - Queue(): ONE in-order queue (no out-of-order execution, no profiling). Commands run in
 //    the order they are enqueued, so a kernel may use the output of the previous one without
 //    events; a host read with blocking=CL_TRUE waits for everything enqueued before it.
-//  - Buffers: whoever creates a cl::Buffer owns it (cl:: objects are reference counted; keep
-//    them as members of the class that uses them and reuse them across images). The context
-//    only owns the context, the queue and the program cache.
+//  - Buffers: made with Buffer() (or ReadOnlyBuffer below), which names a buffer larger than the
+//    device's largest allocation before asking for it. Whoever creates a cl::Buffer owns it (cl::
+//    objects are reference counted; keep them as members of the class that uses them and reuse
+//    them across images). The context only owns the context, the queue and the program cache.
 //  - Thread-safety: Program() is thread-safe (a mutex guards the cache). Everything else
 //    (enqueueing on Queue(), setting kernel arguments) is NOT synchronised: use one context
 //    per thread, or serialise the callers. cl::Kernel objects are not shareable between
@@ -64,6 +65,14 @@ class OpenCLContext {
   std::string DeviceName() const { return device_name_; }
   std::string PlatformName() const { return platform_name_; }
   bool IsCpu() const { return is_cpu_; }
+  // CL_DEVICE_MAX_MEM_ALLOC_SIZE: the largest buffer the device allocates.
+  size_t MaxAllocBytes() const { return max_alloc_bytes_; }
+
+  // A buffer of `bytes` bytes in this context (`host`: the CL_MEM_*_HOST_PTR memory, if the flags
+  // name one). Throws hairmvs::Error naming the size, the device and its limit when `bytes`
+  // exceeds MaxAllocBytes(): drivers answer that with CL_INVALID_BUFFER_SIZE, or only fail at the
+  // first kernel that touches the buffer, and neither says which buffer or by how much.
+  cl::Buffer Buffer(cl_mem_flags flags, size_t bytes, void* host = nullptr) const;
 
   // The program built from the named files of kernels/ (concatenated in order; `#include
   // "x.clh"` lines resolved from the embedded sources, each file at most once), for this
@@ -87,6 +96,7 @@ class OpenCLContext {
   std::string device_name_;
   std::string platform_name_;
   bool is_cpu_ = false;
+  size_t max_alloc_bytes_ = 0;
 
   std::mutex program_mutex_;
   // Keyed by full source text + "\n//options: " + options. std::map keeps references stable.

@@ -132,6 +132,32 @@ TEST(OpenCLContext, FailedCallsAreDescribed) {
   EXPECT_EQ(DescribeException(Error("plain")), "plain");
 }
 
+// A buffer beyond the device's largest allocation is refused before it is asked for, naming its
+// size, the device, the limit and what to do; one within the limit is made with its flags.
+TEST(OpenCLContext, BufferBeyondTheLargestAllocationIsNamed) {
+  auto context = OpenCLContext::Create();
+  const size_t max_alloc = context->MaxAllocBytes();
+  EXPECT_EQ(max_alloc, context->Device().getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>());
+  try {
+    context->Buffer(CL_MEM_READ_WRITE, max_alloc + 1);
+    ADD_FAILURE() << "a buffer beyond CL_DEVICE_MAX_MEM_ALLOC_SIZE was made";
+  } catch (const Error& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("(" + std::to_string(max_alloc + 1) + " bytes) exceeds the largest "
+                           "allocation of OpenCL device '" + context->DeviceName() + "'"),
+              std::string::npos)
+        << message;
+    EXPECT_NE(message.find("--OrientationStereo.max_image_size"), std::string::npos) << message;
+  }
+  std::vector<float> host = {1.5f, -2.0f, 3.25f};
+  const cl::Buffer copied = context->Buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
+                                            sizeof(float) * host.size(), host.data());
+  EXPECT_EQ(copied.getInfo<CL_MEM_FLAGS>(), CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR);
+  std::vector<float> read(host.size());
+  context->Queue().enqueueReadBuffer(copied, CL_TRUE, 0, sizeof(float) * read.size(), read.data());
+  EXPECT_EQ(read, host);
+}
+
 // Data shorter than the 4 bytes a buffer needs (an empty array, whose data() may be null; one
 // byte) is padded with zeros, not read beyond; longer data is copied as it is.
 TEST(OpenCLContext, ReadOnlyBufferOfShortData) {

@@ -168,7 +168,6 @@ std::vector<FloatMap> OrientationFieldComputer::Compute(const FloatMap& gray,
 FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const FloatMap& mask) {
   CheckInputs(gray, mask);
   DeviceState& s = *state_;
-  cl::Context& ctx = context_->Context();
   cl::CommandQueue& queue = context_->Queue();
   const int w = gray.Width(), h = gray.Height();
   const int vec = config_.vector_width;
@@ -201,17 +200,17 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     }
     const size_t padded_bytes = s.padded_host.size() * sizeof(float);
     if (padded_bytes > s.padded_capacity) {
-      s.padded = cl::Buffer(ctx, CL_MEM_READ_ONLY, padded_bytes);
+      s.padded = context_->Buffer(CL_MEM_READ_ONLY, padded_bytes);
       s.padded_capacity = padded_bytes;
     }
     const size_t mask_bytes = s.mask_host.size() * sizeof(float);
     if (mask_bytes > s.mask_capacity) {
-      s.mask = cl::Buffer(ctx, CL_MEM_READ_ONLY, mask_bytes);
+      s.mask = context_->Buffer(CL_MEM_READ_ONLY, mask_bytes);
       s.mask_capacity = mask_bytes;
     }
     const size_t out_bytes = 2 * mask_bytes;
     if (out_bytes > s.out_capacity) {
-      s.out = cl::Buffer(ctx, CL_MEM_WRITE_ONLY, out_bytes);
+      s.out = context_->Buffer(CL_MEM_WRITE_ONLY, out_bytes);
       s.out_capacity = out_bytes;
     }
     if (padded_stride != s.tap_offsets_stride) {

@@ -125,8 +125,8 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
       planes[3 * n + p] = sq;
     }
     cl::Buffer in = ReadOnlyBuffer(context, planes);
-    cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
-    ref_stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * planes.size());
+    cl::Buffer scratch = context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * planes.size());
+    ref_stats_ = context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * planes.size());
     box_->Mean(in, scratch, ref_stats_, width_, height_, 4, ncc_radius_);
     context->Queue().finish();
   }
@@ -170,9 +170,9 @@ void CostVolumeCL::ComputePhotometric(const cl::Buffer& label_base, float label_
   queue.enqueueFillBuffer(out, 0.0f, 0, sizeof(float) * n * num_slices);
   if (num_slices > warp_slices_) {
     const size_t bytes = sizeof(float) * 6 * n * num_slices;
-    warp_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
-    warp_scratch_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
-    warp_means_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
+    warp_ = context_->Buffer(CL_MEM_READ_WRITE, bytes);
+    warp_scratch_ = context_->Buffer(CL_MEM_READ_WRITE, bytes);
+    warp_means_ = context_->Buffer(CL_MEM_READ_WRITE, bytes);
     warp_slices_ = num_slices;
   }
   for (int v = 0; v < num_views_; ++v) {
@@ -209,7 +209,7 @@ FloatMap CostVolumeCL::Compute(const std::vector<float>& label_base, float label
   CHECK_EQ(label_base.size(), static_cast<size_t>(width_) * height_);
   cl::Buffer base = ReadOnlyBuffer(context_, label_base);
   FloatMap out(width_, height_, num_slices);
-  cl::Buffer buffer(context_->Context(), CL_MEM_READ_WRITE, sizeof(float) * out.Data().size());
+  cl::Buffer buffer = context_->Buffer(CL_MEM_READ_WRITE, sizeof(float) * out.Data().size());
   Compute(base, label_step, slice_begin, num_slices, labels, buffer);
   context_->Queue().enqueueReadBuffer(buffer, CL_TRUE, 0, sizeof(float) * out.Data().size(),
                                       out.Data().data());

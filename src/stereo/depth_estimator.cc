@@ -383,7 +383,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     const int gw = levels[grid_level].width, gh = levels[grid_level].height;
     const size_t grid_pixels = static_cast<size_t>(gw) * gh;
     std::vector<float> host(grid_pixels * num_labels);
-    cl::Buffer volume(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * host.size());
+    cl::Buffer volume = context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * host.size());
     queue.enqueueFillBuffer(volume, 0.0f, 0, sizeof(float) * host.size());
     const int block = std::max(1, std::min(options.slice_block, num_labels));
     // The levels used count for the paper's three (kDataTermLevelsScale), so that the data term
@@ -410,7 +410,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     cl::Buffer source_volumes;
     if (select_sources) {
       const size_t bytes = sizeof(float) * host.size() * num_costs;
-      source_volumes = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, bytes);
+      source_volumes = context->Buffer(CL_MEM_READ_WRITE, bytes);
       queue.enqueueFillBuffer(source_volumes, 0.0f, 0, bytes);
     }
     for (int s0 = 0; s0 < num_labels; s0 += block) {

@@ -77,7 +77,7 @@ void GeometricPriorCL::Add(const StereoCamera& grid_camera, double level0_px_per
   cl::Buffer active_buffer = active.empty() ? ReadOnlyBuffer(context_, &all_active, 1)
                                             : ReadOnlyBuffer(context_, active);
   // The host volume itself (a CPU device adds in place; another copies it there and back).
-  cl::Buffer volume_buffer(context_->Context(), CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
+  cl::Buffer volume_buffer = context_->Buffer(CL_MEM_READ_WRITE | CL_MEM_USE_HOST_PTR,
                            sizeof(float) * volume->size(), volume->data());
   const float per_view =
       static_cast<float>(weight_ * cost_scale / num_views_);

@@ -63,9 +63,9 @@ GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, in
   const int n = width_ * height_;
   const size_t plane_bytes = sizeof(float) * n;
   guide_ = ReadOnlyBuffer(context, guide.Data());
-  cl::Buffer planes(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
-  cl::Buffer scratch(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
-  stats_ = cl::Buffer(context->Context(), CL_MEM_READ_WRITE, 3 * plane_bytes);
+  cl::Buffer planes = context->Buffer(CL_MEM_READ_WRITE, 3 * plane_bytes);
+  cl::Buffer scratch = context->Buffer(CL_MEM_READ_WRITE, 3 * plane_bytes);
+  stats_ = context->Buffer(CL_MEM_READ_WRITE, 3 * plane_bytes);
   cl::Kernel guide_planes(GuidedFilterProgram(context), "gf_guide_planes");
   guide_planes.setArg(0, guide_);
   guide_planes.setArg(1, planes);
@@ -82,8 +82,8 @@ GuidedFilterCL::GuidedFilterCL(OpenCLContext* context, const FloatMap& guide, in
 void GuidedFilterCL::EnsureScratch(int num_slices) {
   if (num_slices <= scratch_slices_) return;
   const size_t bytes = sizeof(float) * 3 * static_cast<size_t>(width_) * height_ * num_slices;
-  planes_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
-  scratch_ = cl::Buffer(context_->Context(), CL_MEM_READ_WRITE, bytes);
+  planes_ = context_->Buffer(CL_MEM_READ_WRITE, bytes);
+  scratch_ = context_->Buffer(CL_MEM_READ_WRITE, bytes);
   scratch_slices_ = num_slices;
 }
 
@@ -113,7 +113,7 @@ FloatMap GuidedFilterCL::Filter(const FloatMap& input) {
   CHECK_EQ(input.Width(), width_);
   CHECK_EQ(input.Height(), height_);
   const size_t bytes = sizeof(float) * input.Data().size();
-  cl::Buffer buffer(context_->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
+  cl::Buffer buffer = context_->Buffer(CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
                     const_cast<float*>(input.Data().data()));
   Filter(buffer, input.Channels(), buffer);
   FloatMap output(width_, height_, input.Channels());
