@@ -15,16 +15,12 @@
 namespace hairmvs {
 namespace testing_util {
 
-// A fresh, empty folder for a test: <build folder>/test_tmp/hairmvs_<name> (the system's
-// temporary folder where the build folder is not known), the tests' one way to make one. A
-// test's next run replaces it, so runs leave one copy at most; two checkouts' suites run at once
-// have their own build folders, so they do not share the folders either.
+// A fresh, empty folder for a test, <build folder>/test_tmp/hairmvs_<name> (HAIRMVS_BINARY_DIR
+// is defined for every hairmvs_add_test target): the tests' one way to make one. A test's next
+// run replaces it, so runs leave one copy at most; two checkouts' suites run at once have their
+// own build folders, so they do not share the folders.
 inline std::string MakeTestDir(const std::string& name) {
-#ifdef HAIRMVS_BINARY_DIR
   const std::filesystem::path root = std::filesystem::path(HAIRMVS_BINARY_DIR) / "test_tmp";
-#else
-  const std::filesystem::path root = std::filesystem::temp_directory_path();
-#endif
   const std::string dir = (root / ("hairmvs_" + name)).string();
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 #include "src/opencl/opencl_error.h"
 #include "src/opencl/opencl_options.h"
 
@@ -138,17 +139,13 @@ TEST(OpenCLContext, BufferBeyondTheLargestAllocationIsNamed) {
   auto context = OpenCLContext::Create();
   const size_t max_alloc = context->MaxAllocBytes();
   EXPECT_EQ(max_alloc, context->Device().getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>());
-  try {
-    context->Buffer(CL_MEM_READ_WRITE, max_alloc + 1);
-    ADD_FAILURE() << "a buffer beyond CL_DEVICE_MAX_MEM_ALLOC_SIZE was made";
-  } catch (const Error& e) {
-    const std::string message = e.what();
-    EXPECT_NE(message.find("(" + std::to_string(max_alloc + 1) + " bytes) exceeds the largest "
-                           "allocation of OpenCL device '" + context->DeviceName() + "'"),
-              std::string::npos)
-        << message;
-    EXPECT_NE(message.find("--OrientationStereo.max_image_size"), std::string::npos) << message;
-  }
+  const std::string message =
+      testing_util::ErrorOf([&] { context->Buffer(CL_MEM_READ_WRITE, max_alloc + 1); });
+  EXPECT_NE(message.find("(" + std::to_string(max_alloc + 1) + " bytes) exceeds the largest "
+                         "allocation of OpenCL device '" + context->DeviceName() + "'"),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find("--OrientationStereo.max_image_size"), std::string::npos) << message;
   std::vector<float> host = {1.5f, -2.0f, 3.25f};
   const cl::Buffer copied = context->Buffer(CL_MEM_READ_ONLY | CL_MEM_COPY_HOST_PTR,
                                             sizeof(float) * host.size(), host.data());
