@@ -739,14 +739,75 @@ Reconstruction ReadReconstruction(const std::string& dir) {
                          "format, .bin or .txt)"
                       << hint.str());
   }
-  const std::string images_file =
-      JoinPaths(dir, HasModelFiles(dir, ".bin") ? "images.bin" : "images.txt");
+  const std::string extension = HasModelFiles(dir, ".bin") ? ".bin" : ".txt";
+  const std::string images_file = JoinPaths(dir, "images" + extension);
   for (const auto& [id, image] : r.images) {
     THROW_IF(!r.cameras.count(image.camera_id),
              images_file << ": image " << id << " (" << image.name << ") refers to camera "
                          << image.camera_id << ", which is not in the cameras file");
   }
+  const std::string inconsistencies =
+      DescribeTrackInconsistencies(r, JoinPaths(dir, "points3D" + extension), images_file);
+  if (!inconsistencies.empty()) {
+    LOG(WARNING) << inconsistencies
+                 << " Source views and depth ranges pass over them; a model that COLMAP's "
+                    "mapper or point_triangulator wrote has none.";
+  }
   return r;
+}
+
+std::string DescribeTrackInconsistencies(const Reconstruction& reconstruction,
+                                         const std::string& points_file,
+                                         const std::string& images_file) {
+  // How many of a kind, and the first, so that it can be looked up in the file.
+  struct Count {
+    size_t n = 0;
+    std::string first;
+  };
+  Count unknown_image, bad_keypoint, unknown_point;
+  size_t num_elements = 0, num_keypoints = 0;
+  for (const auto& [point_id, point] : reconstruction.points3D) {
+    for (const TrackElement& el : point.track) {
+      ++num_elements;
+      const auto image = reconstruction.images.find(el.image_id);
+      if (image == reconstruction.images.end()) {
+        if (unknown_image.n++ == 0) {
+          unknown_image.first = "point " + std::to_string(point_id) + " -> image " +
+                                std::to_string(el.image_id);
+        }
+      } else if (el.point2D_idx >= image->second.points2D.size() && bad_keypoint.n++ == 0) {
+        bad_keypoint.first = "point " + std::to_string(point_id) + " -> keypoint " +
+                             std::to_string(el.point2D_idx) + " of image " +
+                             std::to_string(el.image_id) + " (" + image->second.name +
+                             "), which has " + std::to_string(image->second.points2D.size());
+      }
+    }
+  }
+  for (const auto& [image_id, image] : reconstruction.images) {
+    for (const Point2D& p : image.points2D) {
+      if (p.point3D_id == kInvalidPoint3DId) continue;
+      ++num_keypoints;
+      if (!reconstruction.points3D.count(p.point3D_id) && unknown_point.n++ == 0) {
+        unknown_point.first = "image " + std::to_string(image_id) + " (" + image.name +
+                              ") -> point " + std::to_string(p.point3D_id);
+      }
+    }
+  }
+  std::ostringstream out;
+  auto sentence = [&out](const std::string& file, const Count& count, size_t total,
+                         const char* what) {
+    if (count.n == 0) return;
+    if (out.tellp() > 0) out << " ";
+    out << file << ": " << count.n << " of " << total << " " << what << " (first: "
+        << count.first << ").";
+  };
+  sentence(points_file, unknown_image, num_elements,
+           "track elements name an image that is not in the model");
+  sentence(points_file, bad_keypoint, num_elements,
+           "track elements name a keypoint beyond their image's keypoints");
+  sentence(images_file, unknown_point, num_keypoints,
+           "triangulated keypoints name a 3D point that is not in the model");
+  return out.str();
 }
 
 void WriteReconstruction(const Reconstruction& reconstruction, const std::string& dir,

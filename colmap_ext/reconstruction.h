@@ -118,7 +118,17 @@ enum class ModelFormat { kBinary, kText };
 // bytes, unknown model id, wrong parameter count, malformed line, a camera size outside
 // [1, kMaxCameraSizePx], a parameter that is nan or inf, a focal length that is not > 0, two
 // images with the same name).
+// A model whose tracks and keypoints disagree still reads (source views and depth ranges pass
+// over what does not resolve), with a warning that DescribeTrackInconsistencies words.
 Reconstruction ReadReconstruction(const std::string& dir);
+
+// What of the model's sparse points does not resolve, one sentence per kind (empty when
+// everything does): track elements naming an image that is not in the model or a keypoint
+// index beyond that image's keypoints, and keypoints naming a 3D point that is not there.
+// `points_file` / `images_file` name where each kind was read from.
+std::string DescribeTrackInconsistencies(const Reconstruction& reconstruction,
+                                         const std::string& points_file,
+                                         const std::string& images_file);
 // Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, as one
 // unit (WriteFilesAtomically): if any file fails, the old model is left whole. Throws
 // hairmvs::Error naming `dir` for a text model where all three .bin files are (readers would

@@ -426,6 +426,31 @@ TEST(Reconstruction, ImageWithUnknownCameraIsAnError) {
   ExpectErrorMentions([&] { ReadReconstruction(dir); }, {"images.txt", "camera 99"});
 }
 
+TEST(Reconstruction, InconsistentTracksAreNamedButRead) {
+  Reconstruction model = MakePlaneModel();
+  EXPECT_EQ(DescribeTrackInconsistencies(model, "p", "i"), "");
+  model.points3D.at(3).track[0].image_id = 99;
+  model.points3D.at(4).track[1].point2D_idx = 1000;
+  model.points3D.at(5).track[2].point2D_idx = 2000;
+  model.points3D.erase(7);  // its keypoints in all three images now name a missing point
+  const std::string message = DescribeTrackInconsistencies(model, "p.bin", "i.bin");
+  // 40 points seen by 3 images, less the 3 elements of the erased point.
+  const std::vector<std::string> parts = {
+      "p.bin: 1 of 117 track elements name an image that is not in the model "
+      "(first: point 3 -> image 99).",
+      "p.bin: 2 of 117 track elements name a keypoint beyond their image's keypoints "
+      "(first: point 4 -> keypoint 1000 of image 2 (b.png), which has 40).",
+      "i.bin: 3 of 120 triangulated keypoints name a 3D point that is not in the model "
+      "(first: image 1 (a.png) -> point 7)."};
+  for (const std::string& part : parts) {
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+  }
+  // Such a model still reads, as it was written.
+  const std::string dir = MakeTestDir("inconsistent_tracks");
+  WriteReconstruction(model, dir, ModelFormat::kBinary);
+  ExpectModelsEqual(model, ReadReconstruction(dir));
+}
+
 // Writes `model` as a text model in a fresh folder `name`, lets `edit` change the text of
 // `file` (cameras.txt, images.txt), and returns the error of reading it back.
 template <typename Edit>
