@@ -6,7 +6,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -140,48 +139,6 @@ std::string DescribeStatus(int status) {
   return "status " + std::to_string(status);
 }
 
-// Scratch folders are named <prefix><pid>_<n>. One whose process is gone was left by a run
-// that a signal ended before it could remove it (the interrupt handler removes files, not
-// folders): removed by the next run that makes one in the same place.
-void RemoveScratchOfEndedRuns(const fs::path& parent, const std::string& prefix) {
-  std::error_code ec;
-  for (const fs::directory_entry& entry : fs::directory_iterator(parent, ec)) {
-    const std::string name = entry.path().filename().string();
-    if (name.rfind(prefix, 0) != 0 || !entry.is_directory(ec)) continue;
-    const std::string rest = name.substr(prefix.size());
-    const size_t digits = std::min(rest.find_first_not_of("0123456789"), rest.size());
-    if (digits == 0 || digits > 9 || (digits < rest.size() && rest[digits] != '_')) continue;
-    const long pid = std::stol(rest.substr(0, digits));
-    if (pid == getpid() || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
-    LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
-              << ") that was stopped";
-    fs::remove_all(entry.path(), ec);
-  }
-}
-
-// A folder <parent>/<prefix><pid>_<n>, removed with everything in it at the end.
-class ScratchDir {
- public:
-  ScratchDir(const fs::path& parent, const std::string& prefix) {
-    RemoveScratchOfEndedRuns(parent, prefix);
-    path_ = (parent / (prefix + std::to_string(getpid()) + "_" + std::to_string(counter_++)))
-                .string();
-    fs::remove_all(path_);
-    CreateDirs(path_);
-  }
-  ~ScratchDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  ScratchDir(const ScratchDir&) = delete;
-  ScratchDir& operator=(const ScratchDir&) = delete;
-  const std::string& Path() const { return path_; }
-
- private:
-  static inline std::atomic<int> counter_{0};
-  std::string path_;
-};
-
 // Moves what `from` holds into `to` (created if need be), sparse/ last: a workspace is whole
 // once its sparse/ exists (the pipeline creates one where sparse/ is missing). Nothing is moved
 // when an entry would replace one `to` has already.
@@ -221,7 +178,7 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   CreateDirs(target.parent_path().string());
   // Beside the workspace (the same file system, so that its entries are renamed, not copied),
   // hidden, and removed if anything fails or colmap is stopped.
-  const ScratchDir staging(target.parent_path(),
+  const ScratchDir staging(target.parent_path().string(),
                            "." + target.filename().string() + ".undistorting");
   const int status = Undistort(colmap_executable, image_path, input_path, staging.Path());
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
@@ -250,7 +207,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
   const Workspace workspace = Workspace::Read(workspace_path, mask_path);
-  const ScratchDir scratch(fs::temp_directory_path(), "hairmvs_masks_");
+  const ScratchDir scratch(fs::temp_directory_path().string(), "hairmvs_masks_");
   const std::string binarised = JoinPaths(scratch.Path(), "masks");
   const std::string list_path = JoinPaths(scratch.Path(), "image_list.txt");
   // Where an image's undistorted mask goes.

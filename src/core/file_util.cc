@@ -4,6 +4,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cerrno>
 #include <cstring>
@@ -247,21 +248,61 @@ void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>&
   WriteFilesAtomically(files);
 }
 
-StagingDir::StagingDir(const std::string& parent, const std::string& name)
-    : parent_(parent), path_(TemporaryPathFor(JoinPaths(parent, name))) {
+namespace {
+
+std::string HostName() {
+  char name[256] = {};
+  if (gethostname(name, sizeof(name) - 1) != 0 || name[0] == '\0') return "localhost";
+  return name;
+}
+
+// Removes the folders <prefix><pid>_<n>@<host> in `parent` whose process on this host has ended
+// (see ScratchDir). A name without "@<host>" (made before hosts were named) counts as this
+// host's.
+void RemoveScratchOfEndedRuns(const std::string& parent, const std::string& prefix,
+                              const std::string& host) {
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(parent, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind(prefix, 0) != 0 || !entry.is_directory(ec)) continue;
+    const std::string rest = name.substr(prefix.size());
+    const size_t digits = std::min(rest.find_first_not_of("0123456789"), rest.size());
+    if (digits == 0 || digits > 9 || digits == rest.size() || rest[digits] != '_') continue;
+    const size_t at = rest.find('@', digits);
+    if (at != std::string::npos && rest.substr(at + 1) != host) continue;
+    const long pid = std::stol(rest.substr(0, digits));
+    if (pid == getpid() || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
+              << ") that was stopped";
+    fs::remove_all(entry.path(), ec);
+  }
+}
+
+}  // namespace
+
+ScratchDir::ScratchDir(const std::string& parent, const std::string& prefix) {
+  static std::atomic<int> counter{0};
+  const std::string host = HostName();
+  RemoveScratchOfEndedRuns(parent, prefix, host);
+  path_ = JoinPaths(parent, prefix + std::to_string(getpid()) + "_" +
+                                std::to_string(counter++) + "@" + host);
+  std::error_code ec;
+  fs::remove_all(path_, ec);
   CreateDirs(path_);
 }
 
-StagingDir::~StagingDir() {
-  if (committed_) return;
+ScratchDir::~ScratchDir() {
   std::error_code ec;
   fs::remove_all(path_, ec);
 }
 
+StagingDir::StagingDir(const std::string& parent, const std::string& name)
+    : parent_(parent), scratch_(parent, "." + name + ".staging") {}
+
 void StagingDir::Commit(const std::vector<std::string>& entries) {
-  THROW_IF(committed_, "StagingDir " << path_ << " was committed already");
+  THROW_IF(committed_, "StagingDir " << Path() << " was committed already");
   for (const std::string& entry : entries) {
-    const std::string from = JoinPaths(path_, entry);
+    const std::string from = JoinPaths(Path(), entry);
     const std::string to = JoinPaths(parent_, entry);
     std::error_code ec;
     THROW_IF(!fs::exists(fs::symlink_status(from, ec)),
@@ -271,15 +312,13 @@ void StagingDir::Commit(const std::vector<std::string>& entries) {
                             << " exists already (written by another process meanwhile?)");
   }
   for (const std::string& entry : entries) {
-    const std::string from = JoinPaths(path_, entry);
+    const std::string from = JoinPaths(Path(), entry);
     const std::string to = JoinPaths(parent_, entry);
     std::error_code ec;
     fs::rename(from, to, ec);
     THROW_IF(ec, "Cannot rename " << from << " to " << to << ": " << ec.message());
   }
   committed_ = true;
-  std::error_code ec;
-  fs::remove_all(path_, ec);
 }
 
 void RemoveTemporaryFilesOnInterrupt() {

@@ -62,29 +62,46 @@ void CopyFileAtomically(const std::string& from, const std::string& to);
 // Each pair's `from` copied to its `to` as one unit (WriteFilesAtomically).
 void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>& from_to);
 
-// A hidden folder `.<name>.tmp<pid>_<n>` inside `parent` (created, with `parent`), in which an
-// output that is only valid as a whole (a synthesized data set: images, masks, model and truth)
-// is built: Commit() renames its named entries into `parent`, where none of them may exist yet;
+// A folder `<parent>/<prefix><pid>_<n>@<host>` (made empty, with `parent`), removed with
+// everything in it when destroyed. A process that a signal ends cannot remove it (the interrupt
+// handler removes files, which is async-signal-safe, not folder trees), so each new one first
+// removes the folders of the same prefix in `parent` whose process has ended, naming each in
+// the log; those of other hosts (a folder shared over the network) are left, since their
+// processes cannot be looked up from here.
+class ScratchDir {
+ public:
+  ScratchDir(const std::string& parent, const std::string& prefix);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::string& Path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+// A hidden ScratchDir `.<name>.staging<pid>_<n>@<host>` inside `parent`, in which an output
+// that is only valid as a whole (a synthesized data set: images, masks, model and truth) is
+// built: Commit() renames its named entries into `parent`, where none of them may exist yet;
 // destroyed uncommitted (the work threw), it is removed with everything in it, so a failed run
-// leaves nothing that the next one would have to refuse or overwrite. A process killed outright
-// leaves it, hidden, beside the outputs it never replaced.
+// leaves nothing that the next one would have to refuse or overwrite. One that a killed process
+// left is removed by the next run (ScratchDir).
 class StagingDir {
  public:
   StagingDir(const std::string& parent, const std::string& name);
-  ~StagingDir();
   StagingDir(const StagingDir&) = delete;
   StagingDir& operator=(const StagingDir&) = delete;
 
   // The folder to write into.
-  const std::string& Path() const { return path_; }
-  // Moves each of `entries` (names inside Path()) to `parent`/<entry>, in order, then removes
-  // Path(). Throws hairmvs::Error naming the entry when one is missing here or exists already
-  // in `parent` (checked for all before any is moved), or when a rename fails.
+  const std::string& Path() const { return scratch_.Path(); }
+  // Moves each of `entries` (names inside Path()) to `parent`/<entry>, in order. Throws
+  // hairmvs::Error naming the entry when one is missing here or exists already in `parent`
+  // (checked for all before any is moved), or when a rename fails.
   void Commit(const std::vector<std::string>& entries);
 
  private:
   std::string parent_;
-  std::string path_;
+  ScratchDir scratch_;
   bool committed_ = false;
 };
 

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <csignal>
 #include <cstdlib>
@@ -181,6 +183,43 @@ TEST(FileUtil, FailedWriteSaysWhy) {
   EXPECT_NE(message.find("to " + folder + ": Is a directory"), std::string::npos) << message;
   EXPECT_TRUE(ExistsDir(folder));
   EXPECT_EQ(testing_util::NumEntriesIn(dir), 1);
+}
+
+// A scratch folder that a stopped run left on this host is removed by the next one of the same
+// prefix; those of running processes, of other hosts and of other prefixes are kept.
+TEST(FileUtil, ScratchDirRemovesTheFoldersOfEndedRunsOfThisHost) {
+  const std::string dir = MakeTestDir("scratch");
+  std::string host;
+  {
+    const ScratchDir probe(dir, ".set.staging");
+    host = probe.Path().substr(probe.Path().rfind('@') + 1);
+    EXPECT_FALSE(host.empty()) << probe.Path();
+    EXPECT_TRUE(ExistsDir(probe.Path()));
+  }
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 0);
+  const pid_t ended = fork();
+  if (ended == 0) _exit(0);
+  ASSERT_EQ(waitpid(ended, nullptr, 0), ended);
+  const std::string gone = std::to_string(ended);
+  const std::vector<std::string> removed = {".set.staging" + gone + "_0@" + host,
+                                            ".set.staging" + gone + "_3"};  // no host: this one
+  const std::vector<std::string> kept = {
+      ".set.staging1_0@" + host,                     // init's: running
+      ".set.staging" + gone + "_0@another-" + host,  // its process cannot be looked up
+      ".other.staging" + gone + "_0@" + host,        // another prefix
+      ".set.stagingx_0@" + host};                    // not a scratch name
+  for (const auto* names : {&removed, &kept}) {
+    for (const std::string& name : *names) CreateDirs(JoinPaths(dir, name, "images"));
+  }
+  {
+    const ScratchDir scratch(dir, ".set.staging");
+    for (const std::string& name : removed) EXPECT_FALSE(ExistsDir(JoinPaths(dir, name))) << name;
+    for (const std::string& name : kept) EXPECT_TRUE(ExistsDir(JoinPaths(dir, name))) << name;
+    const std::string own = JoinPaths(dir, ".set.staging" + std::to_string(getpid()) + "_");
+    EXPECT_EQ(scratch.Path().rfind(own, 0), 0u) << scratch.Path();
+    EXPECT_EQ(scratch.Path().substr(scratch.Path().size() - host.size() - 1), "@" + host);
+  }
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), static_cast<int>(kept.size()));
 }
 
 // A folder this process may not write to is named before any work; a missing one is made.
