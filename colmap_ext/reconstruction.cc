@@ -706,7 +706,8 @@ Reconstruction ReadReconstruction(const std::string& dir) {
   Reconstruction r;
   // COLMAP's rule: binary if all three .bin files exist, else text. rigs.* / frames.*
   // (COLMAP 3.12+) are ignored: images.* still holds every pose.
-  if (HasModelFiles(dir, ".bin")) {
+  const bool binary = HasModelFiles(dir, ".bin");
+  if (binary) {
     ReadFile(JoinPaths(dir, "cameras.bin"), ReadCamerasBinary, &r, true);
     ReadFile(JoinPaths(dir, "images.bin"), ReadImagesBinary, &r, true);
     ReadFile(JoinPaths(dir, "points3D.bin"), ReadPoints3DBinary, &r, true);
@@ -739,7 +740,7 @@ Reconstruction ReadReconstruction(const std::string& dir) {
                          "format, .bin or .txt)"
                       << hint.str());
   }
-  const std::string extension = HasModelFiles(dir, ".bin") ? ".bin" : ".txt";
+  const std::string extension = binary ? ".bin" : ".txt";
   const std::string images_file = JoinPaths(dir, "images" + extension);
   for (const auto& [id, image] : r.images) {
     THROW_IF(!r.cameras.count(image.camera_id),

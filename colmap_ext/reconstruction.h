@@ -129,6 +129,7 @@ Reconstruction ReadReconstruction(const std::string& dir);
 std::string DescribeTrackInconsistencies(const Reconstruction& reconstruction,
                                          const std::string& points_file,
                                          const std::string& images_file);
+
 // Writes cameras, images and points3D sorted by id, exactly as COLMAP 3.8 reads them, as one
 // unit (WriteFilesAtomically): if any file fails, the old model is left whole. Throws
 // hairmvs::Error naming `dir` for a text model where all three .bin files are (readers would
