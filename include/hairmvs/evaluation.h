@@ -214,6 +214,9 @@ struct DataTermMetrics {
   double label_step_mm = 0;     // median depth step between the labels around the true depths
   // |depth of the cheapest label - true depth|.
   double median_abs_error_mm = 0;
+  // Median of (depth of the cheapest label - true depth): below 0 the data term leans to the
+  // front of the hair, above 0 behind it.
+  double median_signed_error_mm = 0;
   double within_1_label = 0;  // fractions of num_pixels: cheapest label within 1 label
   double within_5mm = 0;
   double within_10mm = 0;

@@ -22,14 +22,14 @@ namespace {
 // Per evaluated coarse pixel (one view's, or all views' pooled).
 struct DataTermSamples {
   long num_outside_range = 0;
-  std::vector<double> abs_errors_m;    // cheapest label's depth vs the true depth
+  std::vector<double> errors_m;        // cheapest label's depth - the true depth
   std::vector<double> label_errors;    // |cheapest label - true label position|
   std::vector<double> label_steps_m;   // depth step between the labels around the truth
   std::vector<double> true_depth_ranks;
 
   void Append(const DataTermSamples& other) {
     num_outside_range += other.num_outside_range;
-    for (auto [to, from] : {std::pair(&abs_errors_m, &other.abs_errors_m),
+    for (auto [to, from] : {std::pair(&errors_m, &other.errors_m),
                             std::pair(&label_errors, &other.label_errors),
                             std::pair(&label_steps_m, &other.label_steps_m),
                             std::pair(&true_depth_ranks, &other.true_depth_ranks)}) {
@@ -41,16 +41,19 @@ struct DataTermSamples {
 DataTermMetrics Summarize(const std::string& name, const DataTermSamples& samples) {
   DataTermMetrics m;
   m.name = name;
-  m.num_pixels = static_cast<long>(samples.abs_errors_m.size());
+  std::vector<double> abs_errors_m = samples.errors_m;
+  for (double& e : abs_errors_m) e = std::abs(e);
+  m.num_pixels = static_cast<long>(abs_errors_m.size());
   m.num_outside_range = samples.num_outside_range;
   m.label_step_mm = 1e3 * Percentile(samples.label_steps_m, 0.5);
-  m.median_abs_error_mm = 1e3 * Percentile(samples.abs_errors_m, 0.5);
+  m.median_abs_error_mm = 1e3 * Percentile(abs_errors_m, 0.5);
+  m.median_signed_error_mm = 1e3 * Percentile(samples.errors_m, 0.5);
   m.median_true_depth_rank = Percentile(samples.true_depth_ranks, 0.5);
   long n1 = 0, n5 = 0, n10 = 0;
-  for (size_t i = 0; i < samples.abs_errors_m.size(); ++i) {
+  for (size_t i = 0; i < abs_errors_m.size(); ++i) {
     n1 += samples.label_errors[i] <= 1.0;
-    n5 += samples.abs_errors_m[i] <= 5e-3;
-    n10 += samples.abs_errors_m[i] <= 10e-3;
+    n5 += abs_errors_m[i] <= 5e-3;
+    n10 += abs_errors_m[i] <= 10e-3;
   }
   const double n = std::max<long>(1, m.num_pixels);
   m.within_1_label = n1 / n;
@@ -65,6 +68,7 @@ nlohmann::json ToJson(const DataTermMetrics& m) {
           {"num_outside_range", m.num_outside_range},
           {"label_step_mm", m.label_step_mm},
           {"median_abs_error_mm", m.median_abs_error_mm},
+          {"median_signed_error_mm", m.median_signed_error_mm},
           {"within_1_label", m.within_1_label},
           {"within_5mm", m.within_5mm},
           {"within_10mm", m.within_10mm},
@@ -73,9 +77,9 @@ nlohmann::json ToJson(const DataTermMetrics& m) {
 
 std::string TableRow(const DataTermMetrics& m) {
   char line[256];
-  std::snprintf(line, sizeof(line), "%-14s %8ld %7ld %7.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %6.3f\n",
+  std::snprintf(line, sizeof(line), "%-14s %8ld %7ld %7.2f %8.2f %7.2f %6.1f%% %6.1f%% %6.1f%% %6.3f\n",
                 m.name.c_str(), m.num_pixels, m.num_outside_range, m.label_step_mm,
-                m.median_abs_error_mm, 100 * m.within_1_label, 100 * m.within_5mm,
+                m.median_abs_error_mm, m.median_signed_error_mm, 100 * m.within_1_label, 100 * m.within_5mm,
                 100 * m.within_10mm, m.median_true_depth_rank);
   return line;
 }
@@ -151,7 +155,7 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
       const double frac = position - below;
       const double true_cost = (1 - frac) * costs[below] + frac * costs[below + 1];
       const int cheapest = static_cast<int>(lo - costs.begin());
-      samples->abs_errors_m.push_back(std::abs(depths[cheapest] - true_depth));
+      samples->errors_m.push_back(depths[cheapest] - true_depth);
       samples->label_errors.push_back(std::abs(cheapest - position));
       samples->label_steps_m.push_back(std::abs(depths[below + 1] - depths[below]));
       const long cheaper = std::count_if(costs.begin(), costs.end(),
@@ -173,7 +177,7 @@ bool DataTermEvaluationOptions::Check(std::string* error) const {
 
 std::string DataTermEvaluationResult::Table() const {
   return EvaluationTable(
-      "view             pixels outside step_mm  med_mm  <=1lab  <=5mm <=10mm  rank\n", views,
+      "view             pixels outside step_mm  med_mm  sgn_mm  <=1lab  <=5mm <=10mm  rank\n", views,
       overall, json_path, TableRow);
 }
 

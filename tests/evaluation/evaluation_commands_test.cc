@@ -515,6 +515,7 @@ TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
   EXPECT_EQ(at_truth.overall.num_outside_range, 0);
   EXPECT_NEAR(at_truth.overall.label_step_mm, 5.0, 1e-6);
   EXPECT_NEAR(at_truth.overall.median_abs_error_mm, 0.0, 1e-6);
+  EXPECT_NEAR(at_truth.overall.median_signed_error_mm, 0.0, 1e-6);
   EXPECT_DOUBLE_EQ(at_truth.overall.within_1_label, 1.0);
   EXPECT_DOUBLE_EQ(at_truth.overall.within_5mm, 1.0);
   EXPECT_NEAR(at_truth.overall.median_true_depth_rank, 0.0, 1.0 / 31);
@@ -525,11 +526,20 @@ TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
       EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions());
   EXPECT_EQ(shifted.overall.num_pixels, half_hair);
   EXPECT_NEAR(shifted.overall.median_abs_error_mm, 30.0, 1e-6);
+  EXPECT_NEAR(shifted.overall.median_signed_error_mm, 30.0, 1e-6);
   EXPECT_DOUBLE_EQ(shifted.overall.within_1_label, 0.0);
   EXPECT_DOUBLE_EQ(shifted.overall.within_10mm, 0.0);
   EXPECT_NEAR(shifted.overall.median_true_depth_rank, 11.0 / 31, 1e-9);
   const auto json = nlohmann::json::parse(ReadTextFile(shifted.json_path));
   EXPECT_EQ(json["overall"]["num_pixels"].get<long>(), half_hair);
+  EXPECT_NEAR(json["overall"]["median_signed_error_mm"].get<double>(), 30.0, 1e-6);
+
+  // 4 labels (20 mm) in front: the sign says so, the size does not.
+  WriteShiftedVolume(scene, 6);
+  const DataTermMetrics in_front =
+      EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions()).overall;
+  EXPECT_NEAR(in_front.median_abs_error_mm, 20.0, 1e-6);
+  EXPECT_NEAR(in_front.median_signed_error_mm, -20.0, 1e-6);
 
   // Labels from 0.6 m: every true depth lies outside them.
   WriteShiftedVolume(scene, 10, 0.6);
