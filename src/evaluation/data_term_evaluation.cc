@@ -41,8 +41,7 @@ struct DataTermSamples {
 DataTermMetrics Summarize(const std::string& name, const DataTermSamples& samples) {
   DataTermMetrics m;
   m.name = name;
-  std::vector<double> abs_errors_m = samples.errors_m;
-  for (double& e : abs_errors_m) e = std::abs(e);
+  const std::vector<double> abs_errors_m = Absolute(samples.errors_m);
   m.num_pixels = static_cast<long>(abs_errors_m.size());
   m.num_outside_range = samples.num_outside_range;
   m.label_step_mm = 1e3 * Percentile(samples.label_steps_m, 0.5);
@@ -77,10 +76,11 @@ nlohmann::json ToJson(const DataTermMetrics& m) {
 
 std::string TableRow(const DataTermMetrics& m) {
   char line[256];
-  std::snprintf(line, sizeof(line), "%-14s %8ld %7ld %7.2f %8.2f %7.2f %6.1f%% %6.1f%% %6.1f%% %6.3f\n",
+  std::snprintf(line, sizeof(line),
+                "%-14s %8ld %7ld %7.2f %8.2f %7.2f %6.1f%% %6.1f%% %6.1f%% %6.3f\n",
                 m.name.c_str(), m.num_pixels, m.num_outside_range, m.label_step_mm,
-                m.median_abs_error_mm, m.median_signed_error_mm, 100 * m.within_1_label, 100 * m.within_5mm,
-                100 * m.within_10mm, m.median_true_depth_rank);
+                m.median_abs_error_mm, m.median_signed_error_mm, 100 * m.within_1_label,
+                100 * m.within_5mm, 100 * m.within_10mm, m.median_true_depth_rank);
   return line;
 }
 
@@ -177,8 +177,8 @@ bool DataTermEvaluationOptions::Check(std::string* error) const {
 
 std::string DataTermEvaluationResult::Table() const {
   return EvaluationTable(
-      "view             pixels outside step_mm  med_mm  sgn_mm  <=1lab  <=5mm <=10mm  rank\n", views,
-      overall, json_path, TableRow);
+      "view             pixels outside step_mm  med_mm  sgn_mm  <=1lab  <=5mm <=10mm  rank\n",
+      views, overall, json_path, TableRow);
 }
 
 DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,

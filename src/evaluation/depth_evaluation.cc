@@ -68,11 +68,6 @@ double LayerInWindow(const GroundTruthView& gt, int r, int c, int k, double dept
   return in_front / (k * k);
 }
 
-std::vector<double> Absolute(std::vector<double> values) {
-  for (double& v : values) v = std::abs(v);
-  return values;
-}
-
 DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   DepthMetrics m;
   m.name = name;

@@ -9,6 +9,11 @@
 
 namespace hairmvs {
 
+std::vector<double> Absolute(std::vector<double> values) {
+  for (double& v : values) v = std::abs(v);
+  return values;
+}
+
 double Mean(const std::vector<double>& values) {
   if (values.empty()) return 0.0;
   return std::accumulate(values.begin(), values.end(), 0.0) / values.size();

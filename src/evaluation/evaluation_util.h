@@ -16,6 +16,9 @@
 
 namespace hairmvs {
 
+// |v| of each value (signed errors to absolute ones).
+std::vector<double> Absolute(std::vector<double> values);
+
 // Mean, median and 90th percentile of distances given in metres, reported in mm.
 DistanceStats SummarizeDistances(std::vector<double> distances_m);
 // Percentile q in [0, 1] (nearest rank on the sorted values); 0 for an empty vector.
