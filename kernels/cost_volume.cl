@@ -7,7 +7,8 @@
 // Projection into source view j (SfM pixel convention, at the level's resolution):
 //   u = D * (Hj * (col + 0.5, row + 0.5, 1)) + bj, sample at (u.x / u.z - 0.5, u.y / u.z - 0.5).
 // view_params, per view (16 floats): Hj (9, row-major), bj (3), cos(psi), sin(psi), homography,
-// 0 with psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5. homography = 1: the
+// weight, with psi = 2 (phi_ref - phi_j) the epipole roll correction of Eq. 5 and weight view j's
+// factor in the sum over the views (CostViewInput::weight). homography = 1: the
 // reference orientation is instead carried into view j by the Jacobian, at the pixel, of the
 // homography of the plane the strand lies in (TransferDirection in
 // src/stereo/stereo_geometry.h): fronto-parallel, or, when has_gradient, tilted by
@@ -134,12 +135,12 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
           const float dx = hx - px * hz;
           const float dy = hy - py * hz;
           const float scale = r / (dx * dx + dy * dy);
-          total[i] -= scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
+          total[i] -= m[15] * scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
         } else {
           // conj(O_ref) * O_v = (ore*o.x + oim*o.y) + i (ore*o.y - oim*o.x); times exp(i psi).
           const float re = ore * o.x + oim * o.y;
           const float im = ore * o.y - oim * o.x;
-          total[i] -= re * m[12] - im * m[13];
+          total[i] -= m[15] * (re * m[12] - im * m[13]);
         }
       }
     }

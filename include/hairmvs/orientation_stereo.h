@@ -117,6 +117,27 @@ struct OrientationStereoOptions {
   // weakest, 93.6% / 12.57 / 6.82 / 1.661 / 0.697 against 92.2% / 10.86 / 5.41 / 1.774 / 0.632
   // (first estimates 13.2 mm). With 2: the g2 group 4.09 against 4.04 mm.
   int num_levels = 3;
+  // Level 0's share of each source's orientation cost, by how far the source looks away from
+  // the reference: (level0_weight_angle_deg / angle)^level0_weight_angle_power, clamped to
+  // [1/4, 4], against 1 for every coarser level, the levels' weights then scaled to average 1
+  // (so that each source's cost keeps its scale against lambda). Individual strands, which
+  // level 0 resolves, match across narrow pairs, but across wide ones their occlusions and
+  // turns change while the coarser levels' bands of strands still agree. 0: every level
+  // alike, as the paper. Measured (.geometric maps; complete / per-pixel mean / median / 3D
+  // mean / 3D median, mm), 20 degrees and power 2 against equal levels: synth_straight_gantry
+  // (10 and 20 degree pairs) 98.7% / 7.93 / 4.17 / 1.066 / 0.526 against 98.6% / 8.09 / 4.24 /
+  // 1.122 / 0.526; synth_handheld (6-34 degree pairs) 93.3% / 9.82 / 4.70 / 1.218 / 0.567
+  // against 93.3% / 9.91 / 4.78 / 1.304 / 0.588; the curly demo group 98.2% / 3.46 / 2.31 /
+  // 0.289 / 0.241 against 97.8% / 3.70 / 2.45 / 0.289 / 0.229; but a set of wide pairs only
+  // (`hairmvs synthesize --style curly --rig handheld --num_views 12 --width 800 --seed 7`,
+  // sources 26-89 degrees away) trades: 93.8% / 5.09 / 2.86 / 0.379 / 0.306 against 95.0% /
+  // 4.99 / 2.83 / 0.408 / 0.336. Power 1: the gantry 98.6% / 7.96 / 4.19 / 1.091 / 0.527,
+  // synth_handheld 93.7% / 9.89 / 4.72 / 1.287 / 0.574, the curly demo group 2.37 mm, the
+  // wide set 94.0% / 5.06 / 2.84 / 0.383 / 0.308; 30 degrees (power 1): the g2 group 4.01 mm
+  // (equal levels 4.07), synth_handheld 4.75 mm. One weight for all sources does not do it:
+  // level 0 x 2 / x 0.5 gives the g2 group 4.01 / 4.16 mm but synth_handheld 4.87 / 4.68 mm.
+  double level0_weight_angle_deg = 20;
+  double level0_weight_angle_power = 2;
   // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
   // level 0 (finest), 1, 2. 15/11/7 measured better than 7/11/15 on synth_straight_gantry g0_c
   // (per-pixel median 12.2 vs 14.8 mm). With both passes they hardly matter: the g2 group's
@@ -472,6 +493,10 @@ struct OrientationStereoOptions {
       "with masks: coarse labels start at the visual hull's bound at each pixel");
     v("coarse_smoothness_along_visual_hull", &coarse_smoothness_along_visual_hull,
       "with coarse_labels_from_visual_hull: coarse smoothness on the depth behind the hull");
+    v("level0_weight_angle_deg", &level0_weight_angle_deg,
+      "level 0's weight per source: (this / view angle)^power in [1/4, 4] (0: levels alike)");
+    v("level0_weight_angle_power", &level0_weight_angle_power,
+      "exponent of level0_weight_angle_deg's weight");
     v("fine_num_labels", &fine_num_labels, "labels of the fine band around the coarse depth");
     v("fine_label_step", &fine_label_step, "fine label spacing in coarse labels");
     v("slice_block", &slice_block, "depth slices per kernel launch");
@@ -533,6 +558,9 @@ struct OrientationStereoOptions {
   bool Check(std::string* error) const;
   // Window in px of a level (levels beyond 2 reuse the level-2 window).
   int WindowPx(int level) const;
+  // The factor of a source `view_angle_deg` away from the reference in the orientation cost of
+  // `level` (of num_levels used): level0_weight_angle_deg's weights, averaging 1 over the levels.
+  double LevelSourceWeight(int level, int num_levels, double view_angle_deg) const;
   // Orientation pyramid levels to compute: the data term's and the coarse stage's grid.
   int PyramidLevels() const { return std::max(num_levels, coarse_level + 1); }
   // The name of the maps a view ends with: "geometric" after the geometric pass, else

@@ -71,7 +71,8 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     CHECK_EQ(src.camera.width, src.field.Width());
     CHECK_EQ(src.camera.height, src.field.Height());
     const ViewProjection projection = ComputeViewProjection(ref.camera, src.camera, transfer);
-    const auto packed = projection.Packed();
+    std::array<float, 16> packed = projection.Packed();
+    packed[15] = cost == StereoCost::kOrientation ? src.weight : 1.0f;
     params.insert(params.end(), packed.begin(), packed.end());
     const std::array<int, 4> plane =
         ConcatenatedPlaneDims(src.field.Width(), src.field.Height(), all_sources.size());
@@ -262,7 +263,7 @@ FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostView
                        &yb);
             carried = std::polar(std::abs(o_ref), 2.0 * std::atan2(yb - ya, xb - xa));
           }
-          total -= (std::conj(carried) * o_src).real();
+          total -= sources[v].weight * (std::conj(carried) * o_src).real();
         }
         out.At(row, col, k) = static_cast<float>(total);
       }

@@ -36,6 +36,9 @@ struct CostViewInput {
   // The reference's, for the plane_homography transfer: the gradient of log depth of the plane
   // its strands lie in, per pixel (LogDepthGradient; 2 channels). Empty: fronto-parallel.
   FloatMap log_depth_gradient;
+  // A source's factor in the orientation cost's sum over the sources (the photometric cost
+  // ignores it): OrientationStereoOptions::LevelSourceWeight.
+  float weight = 1.0f;
 };
 
 class CostVolumeCL {

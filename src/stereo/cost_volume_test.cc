@@ -78,6 +78,18 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
                                           labels, OrientationTransfer::kPlaneHomography)),
             2e-4f);
   EXPECT_GT(MaxAbsDiff(tilted_cpu, plane), 0.05f);
+  // Sources weighted (level0_weight_angle_deg): each view's term scaled by its weight.
+  Scene weighted = scene;
+  weighted.sources[0].weight = 0.4f;
+  weighted.sources[1].weight = 2.5f;
+  CostVolumeCL weighted_volume(context.get(), StereoCost::kOrientation, weighted.ref,
+                               weighted.sources, OrientationTransfer::kPlaneHomography);
+  const FloatMap weighted_cpu = OrientationCostCpu(weighted.ref, weighted.sources, weighted.base,
+                                                   0.75f, 5, 7, labels,
+                                                   OrientationTransfer::kPlaneHomography);
+  EXPECT_LT(MaxAbsDiff(weighted_volume.Compute(weighted.base, 0.75f, 5, 7, labels), weighted_cpu),
+            2e-4f);
+  EXPECT_GT(MaxAbsDiff(weighted_cpu, plane), 0.05f);
   // Uniform-in-depth labels too.
   const DepthLabels linear(0.6, 2.0, 32, false);
   CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources,

@@ -346,6 +346,8 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
         std::vector<CostViewInput> src_in;
         for (const StereoViewData* src : sources) {
           src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
+          src_in.back().weight = static_cast<float>(options.LevelSourceWeight(
+              l, num_levels, ViewingAngleDeg(ref.camera, src->camera)));
         }
         // Selecting sources needs each source's aggregated cost: one volume per source.
         std::vector<std::vector<CostViewInput>> groups;

@@ -397,6 +397,36 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());
 }
 
+// Level 0's weight per source: (angle_deg / view angle)^power clamped to [1/4, 4] against 1
+// for the coarser levels, the levels averaging 1; 1 everywhere when off or with one level.
+TEST(OrientationStereoOptions, LevelSourceWeightsFollowTheViewAngle) {
+  OrientationStereoOptions options;
+  options.level0_weight_angle_deg = 20;
+  options.level0_weight_angle_power = 2;
+  for (int l = 0; l < 3; ++l) EXPECT_NEAR(options.LevelSourceWeight(l, 3, 20.0), 1.0, 1e-12);
+  // 14.14 degrees: level 0 x 2 (of 4 / 3 in all): 1.5, then 0.75 and 0.75.
+  const double narrow = 20.0 / std::sqrt(2.0);
+  EXPECT_NEAR(options.LevelSourceWeight(0, 3, narrow), 1.5, 1e-9);
+  EXPECT_NEAR(options.LevelSourceWeight(1, 3, narrow), 0.75, 1e-9);
+  EXPECT_NEAR(options.LevelSourceWeight(2, 3, narrow), 0.75, 1e-9);
+  // 80 degrees: (1/4)^2 clamped to 1/4; 0 degrees: 4.
+  EXPECT_NEAR(options.LevelSourceWeight(0, 3, 80.0), 0.25 / 0.75, 1e-9);
+  EXPECT_NEAR(options.LevelSourceWeight(0, 3, 0.0), 2.0, 1e-9);
+  for (double angle : {0.0, 7.0, 35.0, 80.0}) {
+    double sum = 0;
+    for (int l = 0; l < 3; ++l) sum += options.LevelSourceWeight(l, 3, angle);
+    EXPECT_NEAR(sum, 3.0, 1e-9) << angle;
+    EXPECT_NEAR(options.LevelSourceWeight(0, 1, angle), 1.0, 1e-12) << angle;
+  }
+  options.level0_weight_angle_deg = 0;  // the paper's equal levels
+  EXPECT_NEAR(options.LevelSourceWeight(0, 3, 7.0), 1.0, 1e-12);
+  options.level0_weight_angle_deg = -1;
+  ExpectRefusedNaming(options, "level0_weight_angle_deg");
+  options = OrientationStereoOptions();
+  options.level0_weight_angle_power = 0;
+  ExpectRefusedNaming(options, "level0_weight_angle_power");
+}
+
 // The combined cost's data term is the weighted sum of the orientation and photometric costs'
 // (each aggregated alike), and it recovers the tilted plane as each of them does.
 TEST(DepthEstimator, CombinedCostIsTheWeightedSumOfTheTwoCosts) {

@@ -125,6 +125,21 @@ int OrientationStereoOptions::WindowPx(int level) const {
   return window_px_level2;
 }
 
+double OrientationStereoOptions::LevelSourceWeight(int level, int num_levels,
+                                                   double view_angle_deg) const {
+  if (level0_weight_angle_deg <= 0 || num_levels <= 1) return 1.0;
+  // Coincident axes (a source beside the reference, looking the same way) take the largest
+  // weight rather than a division by zero.
+  constexpr double kMaxRatio = 4.0;
+  const double ratio = view_angle_deg > 0
+                           ? std::pow(level0_weight_angle_deg / view_angle_deg,
+                                      level0_weight_angle_power)
+                           : kMaxRatio;
+  const double level0 = std::clamp(ratio, 1.0 / kMaxRatio, kMaxRatio);
+  const double mean = (level0 + (num_levels - 1)) / num_levels;
+  return (level == 0 ? level0 : 1.0) / mean;
+}
+
 bool OrientationStereoOptions::Check(std::string* error) const {
   std::ostringstream e;
   MrfSolverType solver;
@@ -180,6 +195,10 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (mrf_icm_polish_iterations < 0) e << "mrf_icm_polish_iterations must be >= 0; ";
   if (coarse_level < -1) e << "coarse_level must be >= -1; ";
   if (coarse_first_level < 0) e << "coarse_first_level must be >= 0; ";
+  if (!(level0_weight_angle_deg >= 0 && level0_weight_angle_deg < 180)) {
+    e << "level0_weight_angle_deg must be in [0, 180); ";
+  }
+  if (!(level0_weight_angle_power > 0)) e << "level0_weight_angle_power must be > 0; ";
   if (fine_num_labels < 3) e << "fine_num_labels must be >= 3; ";
   if (!(fine_label_step > 0)) e << "fine_label_step must be > 0; ";
   if (slice_block < 1) e << "slice_block must be >= 1; ";

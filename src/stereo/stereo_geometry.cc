@@ -17,6 +17,7 @@ std::array<float, 16> ViewProjection::Packed() const {
   packed[12] = static_cast<float>(std::cos(psi_rad));
   packed[13] = static_cast<float>(std::sin(psi_rad));
   packed[14] = plane_homography ? 1.0f : 0.0f;
+  packed[15] = 1.0f;  // the view's weight: CostVolumeCL sets it
   return packed;
 }
 
@@ -27,6 +28,12 @@ double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_cen
   const double vx = e.x() - camera.K(0, 2) * e.z();
   const double vy = e.y() - camera.K(1, 2) * e.z();
   return std::atan2(vy, vx);
+}
+
+double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b) {
+  // The third rows of R: the optical axes in the world frame.
+  const double c = std::clamp(a.R.row(2).dot(b.R.row(2)), -1.0, 1.0);
+  return std::acos(c) * 180.0 / M_PI;
 }
 
 ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera& src,

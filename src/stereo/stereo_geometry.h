@@ -67,6 +67,9 @@ FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int heig
 // principal point of `camera` to the epipole of the camera centred at `other_center`.
 double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_center);
 
+// The angle in degrees between two cameras' optical axes.
+double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b);
+
 // Depth labels: label value v in [0, num_labels - 1] (fractional values allowed) maps to
 // t = a + b v, depth = t (uniform in depth) or 1 / t (uniform in inverse depth).
 struct DepthLabels {
