@@ -71,8 +71,8 @@ CostVolumeCL::CostVolumeCL(OpenCLContext* context, StereoCost cost, const CostVi
     CHECK_EQ(src.camera.width, src.field.Width());
     CHECK_EQ(src.camera.height, src.field.Height());
     const ViewProjection projection = ComputeViewProjection(ref.camera, src.camera, transfer);
-    std::array<float, 16> packed = projection.Packed();
-    packed[15] = cost == StereoCost::kOrientation ? src.weight : 1.0f;
+    const std::array<float, 16> packed =
+        projection.Packed(cost == StereoCost::kOrientation ? src.weight : 1.0f);
     params.insert(params.end(), packed.begin(), packed.end());
     const std::array<int, 4> plane =
         ConcatenatedPlaneDims(src.field.Width(), src.field.Height(), all_sources.size());

@@ -8,7 +8,7 @@
 
 namespace hairmvs {
 
-std::array<float, 16> ViewProjection::Packed() const {
+std::array<float, 16> ViewProjection::Packed(float weight) const {
   std::array<float, 16> packed{};
   for (int r = 0; r < 3; ++r) {
     for (int c = 0; c < 3; ++c) packed[3 * r + c] = static_cast<float>(H(r, c));
@@ -17,7 +17,7 @@ std::array<float, 16> ViewProjection::Packed() const {
   packed[12] = static_cast<float>(std::cos(psi_rad));
   packed[13] = static_cast<float>(std::sin(psi_rad));
   packed[14] = plane_homography ? 1.0f : 0.0f;
-  packed[15] = 1.0f;  // the view's weight: CostVolumeCL sets it
+  packed[15] = weight;
   return packed;
 }
 

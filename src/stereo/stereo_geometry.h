@@ -24,8 +24,9 @@ struct ViewProjection {
   // Map each reference orientation through the plane homography instead (psi unused).
   bool plane_homography = false;
   // The 16 floats the cost kernels read: H row-major, b, cos psi, sin psi, plane_homography
-  // (0 or 1), 0.
-  std::array<float, 16> Packed() const;
+  // (0 or 1), and `weight`, the view's factor in the orientation cost's sum over the views
+  // (CostViewInput::weight; the photometric kernel does not read it).
+  std::array<float, 16> Packed(float weight) const;
 };
 
 // ref, src: the cameras of the grids the map goes between (a pyramid level's:

@@ -73,7 +73,7 @@ TEST(StereoGeometry, PlaneHomographyCarriesAStrandDirectionIntoTheSource) {
   const ViewProjection proj =
       ComputeViewProjection(ref, src, OrientationTransfer::kPlaneHomography);
   EXPECT_TRUE(proj.plane_homography);
-  EXPECT_EQ(proj.Packed()[14], 1.0f);
+  EXPECT_EQ(proj.Packed(1.0f)[14], 1.0f);
   auto image_point = [](const StereoCamera& c, const Eigen::Vector3d& p) {
     return Eigen::Vector2d((c.K * (c.R * p + c.t)).hnormalized());
   };
