@@ -42,6 +42,28 @@ class FloatMap {
   std::vector<float> data_;
 };
 
+// The pixels [x_begin, x_end) x [y_begin, y_end) of a map.
+struct PixelBox {
+  int x_begin = 0, y_begin = 0, x_end = 0, y_end = 0;
+  bool Empty() const { return x_end <= x_begin || y_end <= y_begin; }
+};
+
+// The smallest box holding every pixel whose channel 0 is above `threshold` (empty if none).
+inline PixelBox BoundingBoxAbove(const FloatMap& map, float threshold) {
+  PixelBox box{map.Width(), map.Height(), 0, 0};
+  for (int row = 0; row < map.Height(); ++row) {
+    const float* values = map.Channel(0) + static_cast<size_t>(row) * map.Width();
+    for (int col = 0; col < map.Width(); ++col) {
+      if (!(values[col] > threshold)) continue;
+      box.x_begin = std::min(box.x_begin, col);
+      box.x_end = std::max(box.x_end, col + 1);
+      box.y_begin = std::min(box.y_begin, row);
+      box.y_end = row + 1;
+    }
+  }
+  return box.Empty() ? PixelBox() : box;
+}
+
 // The width x height part of `map` whose top-left pixel is (x0, y0), all channels; it must lie
 // inside `map`.
 inline FloatMap CropFloatMap(const FloatMap& map, int x0, int y0, int width, int height) {

@@ -170,32 +170,43 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
   DeviceState& s = *state_;
   cl::CommandQueue& queue = context_->Queue();
   const int w = gray.Width(), h = gray.Height();
+  FloatMap out(w, h, 2);
+  // Only the mask's bounding box is filtered: the field is 0 outside the mask anyway, and the
+  // shared sets' masks (hair and head) cover a fifth of their views, their boxes under a third.
+  // The box's inputs within the filters' reach are the image's own pixels (replicated at the
+  // image's edges, not the box's), so the box's field is the whole image's, byte for byte.
+  const PixelBox box = mask.Empty() ? PixelBox{0, 0, w, h} : BoundingBoxAbove(mask, 0.0f);
+  if (box.Empty()) return out;
   const int vec = config_.vector_width;
   const int pad = bank_.Radius();
-  const int out_stride = static_cast<int>(RoundUpToMultiple(w, vec));
+  const int box_w = box.x_end - box.x_begin, box_h = box.y_end - box.y_begin;
+  const int out_stride = static_cast<int>(RoundUpToMultiple(box_w, vec));
   const int padded_stride = out_stride + 2 * pad;
-  const int padded_rows = h + 2 * pad;
+  const int padded_rows = box_h + 2 * pad;
 
   {
     ScopedStageTimer timer(timings_, "upload");
-    // Pad with replicated edges (also the columns past `w` up to out_stride, which the last
-    // work-item of a row computes and the host discards).
+    // The box and `pad` pixels around it, with the image's edges replicated (also the columns
+    // past the box up to out_stride, which the last work-item of a row computes and the host
+    // discards).
     s.padded_host.resize(static_cast<size_t>(padded_stride) * padded_rows);
     for (int r = 0; r < padded_rows; ++r) {
-      const float* src = gray.Channel(0) + static_cast<size_t>(std::clamp(r - pad, 0, h - 1)) * w;
+      const float* src = gray.Channel(0) +
+                         static_cast<size_t>(std::clamp(box.y_begin + r - pad, 0, h - 1)) * w;
       float* dst = s.padded_host.data() + static_cast<size_t>(r) * padded_stride;
-      std::fill(dst, dst + pad, src[0]);
-      std::copy(src, src + w, dst + pad);
-      std::fill(dst + pad + w, dst + padded_stride, src[w - 1]);
+      for (int c = 0; c < padded_stride; ++c) {
+        dst[c] = src[std::clamp(box.x_begin + c - pad, 0, w - 1)];
+      }
     }
-    s.mask_host.assign(static_cast<size_t>(out_stride) * h, 0.0f);
-    for (int r = 0; r < h; ++r) {
+    s.mask_host.assign(static_cast<size_t>(out_stride) * box_h, 0.0f);
+    for (int r = 0; r < box_h; ++r) {
       float* dst = s.mask_host.data() + static_cast<size_t>(r) * out_stride;
       if (mask.Empty()) {
-        std::fill(dst, dst + w, 1.0f);
+        std::fill(dst, dst + box_w, 1.0f);
       } else {
-        std::copy(mask.Channel(0) + static_cast<size_t>(r) * w,
-                  mask.Channel(0) + static_cast<size_t>(r + 1) * w, dst);
+        const float* src =
+            mask.Channel(0) + static_cast<size_t>(box.y_begin + r) * w + box.x_begin;
+        std::copy(src, src + box_w, dst);
       }
     }
     const size_t padded_bytes = s.padded_host.size() * sizeof(float);
@@ -240,28 +251,28 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     k.setArg(arg++, s.out);
     k.setArg(arg++, blocked_.num_blocks);
     k.setArg(arg++, blocked_.num_orientations);
-    k.setArg(arg++, w);
-    k.setArg(arg++, h);
+    k.setArg(arg++, box_w);
+    k.setArg(arg++, box_h);
     k.setArg(arg++, out_stride);
     k.setArg(arg++, static_cast<float>(options_.confidence_gamma));
     k.setArg(arg++, static_cast<float>(options_.SignedResponseRatio()));
     const cl::NDRange local(config_.local_size_x, config_.local_size_y);
     const cl::NDRange global(RoundUpToMultiple(out_stride / vec, config_.local_size_x),
-                             RoundUpToMultiple(h, config_.local_size_y));
+                             RoundUpToMultiple(box_h, config_.local_size_y));
     queue.enqueueNDRangeKernel(k, cl::NullRange, global, local);
     queue.finish();
   }
 
-  FloatMap out(w, h, 2);
   {
     ScopedStageTimer timer(timings_, "download");
-    s.out_host.resize(2 * static_cast<size_t>(out_stride) * h);
+    s.out_host.resize(2 * static_cast<size_t>(out_stride) * box_h);
     queue.enqueueReadBuffer(s.out, CL_TRUE, 0, s.out_host.size() * sizeof(float),
                             s.out_host.data());
     for (int c = 0; c < 2; ++c) {
-      for (int r = 0; r < h; ++r) {
-        const float* src = s.out_host.data() + (static_cast<size_t>(c) * h + r) * out_stride;
-        std::copy(src, src + w, out.Channel(c) + static_cast<size_t>(r) * w);
+      for (int r = 0; r < box_h; ++r) {
+        const float* src = s.out_host.data() + (static_cast<size_t>(c) * box_h + r) * out_stride;
+        std::copy(src, src + box_w,
+                  out.Channel(c) + static_cast<size_t>(box.y_begin + r) * w + box.x_begin);
       }
     }
   }

@@ -158,39 +158,52 @@ void ExpectMatchesReference(const Reference& ref, const FloatMap& kernel,
 TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
   // An odd size: row tails shorter than a vector, odd sizes at every level.
   const FloatMap gray = MixedImage(83, 61, 7);
-  FloatMap mask(gray.Width(), gray.Height(), 1, 1.0f);
+  // A mask with a hole, whose bounding box is the whole image, and an ellipse whose box
+  // reaches the image's right and bottom edges but not its left and top ones (the kernel
+  // filters only the box, with the image's pixels around it as inputs).
+  FloatMap holed(gray.Width(), gray.Height(), 1, 1.0f);
+  FloatMap ellipse(gray.Width(), gray.Height(), 1, 0.0f);
   for (int row = 0; row < gray.Height(); ++row) {
     for (int col = 0; col < gray.Width(); ++col) {
-      if (std::hypot(col - 60, row - 20) < 9) mask.At(row, col) = 0;
+      if (std::hypot(col - 60, row - 20) < 9) holed.At(row, col) = 0;
+      if (std::hypot((col - 49) / 34.0, (row - 34) / 27.0) < 1) ellipse.At(row, col) = 1;
     }
   }
-  // Dark strands counted (the default) and bright strands only (the paper's rule).
-  for (bool dark_strands : {true, false}) {
-    OrientationFieldOptions options;
-    options.dark_strands = dark_strands;
-    const OrientationFilterBank bank(options);
-    std::vector<Reference> references(3);
-    for (int l = 0; l < 3; ++l) {
-      Reference& ref = references[l];
-      ref.gray = l == 0 ? gray : DownsampleHalf(references[l - 1].gray);
-      ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
-      ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank,
-                                                   options.confidence_gamma,
-                                                   options.SignedResponseRatio(), &ref.responses);
-    }
-    // The default configuration, and one with 8-pixel vectors, a block size that leaves a
-    // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
-    for (const OrientationKernelConfig& config :
-         {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
-      OrientationFieldComputer computer(context_, options, config);
-      const std::vector<FloatMap> levels = computer.Compute(gray, mask);
-      ASSERT_EQ(levels.size(), 3u);
+  ASSERT_EQ(ellipse.At(34, gray.Width() - 1), 1.0f);
+  ASSERT_EQ(ellipse.At(gray.Height() - 1, 49), 1.0f);
+  ASSERT_EQ(ellipse.At(34, 0), 0.0f);
+  ASSERT_EQ(ellipse.At(0, 49), 0.0f);
+  for (const auto& [mask_name, mask] : {std::pair<std::string, FloatMap>{"holed mask", holed},
+                                        std::pair<std::string, FloatMap>{"ellipse", ellipse}}) {
+    // Dark strands counted (the default) and bright strands only (the paper's rule).
+    for (bool dark_strands : {true, false}) {
+      OrientationFieldOptions options;
+      options.dark_strands = dark_strands;
+      const OrientationFilterBank bank(options);
+      std::vector<Reference> references(3);
       for (int l = 0; l < 3; ++l) {
-        ExpectMatchesReference(references[l], levels[l], options,
-                               std::string(dark_strands ? "dark strands too" : "bright only") +
-                                   ", level " + std::to_string(l) + " vec " +
-                                   std::to_string(config.vector_width) + " block " +
-                                   std::to_string(config.block_size));
+        Reference& ref = references[l];
+        ref.gray = l == 0 ? gray : DownsampleHalf(references[l - 1].gray);
+        ref.mask = l == 0 ? mask : DownsampleMask(references[l - 1].mask);
+        ref.field = ComputeOrientationLevelReference(ref.gray, ref.mask, bank,
+                                                     options.confidence_gamma,
+                                                     options.SignedResponseRatio(), &ref.responses);
+      }
+      // The default configuration, and one with 8-pixel vectors, a block size that leaves a
+      // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
+      for (const OrientationKernelConfig& config :
+           {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
+        OrientationFieldComputer computer(context_, options, config);
+        const std::vector<FloatMap> levels = computer.Compute(gray, mask);
+        ASSERT_EQ(levels.size(), 3u);
+        for (int l = 0; l < 3; ++l) {
+          ExpectMatchesReference(references[l], levels[l], options,
+                                 mask_name + ", " +
+                                     (dark_strands ? "dark strands too" : "bright only") +
+                                     ", level " + std::to_string(l) + " vec " +
+                                     std::to_string(config.vector_width) + " block " +
+                                     std::to_string(config.block_size));
+        }
       }
     }
   }
@@ -347,6 +360,10 @@ TEST_F(OrientationFieldTest, MaskedPixelsAreZeroAtEveryLevel) {
     EXPECT_GT(valid_nonzero, static_cast<int>(level_mask.NumPixels() / 8)) << "level " << l;
   }
   EXPECT_THROW(computer.Compute(gray, FloatMap(10, 10, 1)), Error);
+  // A view with no hair at all: every level 0, no error.
+  for (const FloatMap& level : computer.Compute(gray, FloatMap(70, 50, 1, 0.0f))) {
+    for (float v : level.Data()) ASSERT_EQ(v, 0.0f);
+  }
 }
 
 }  // namespace

@@ -710,20 +710,11 @@ void CropAxis(int first, int last, int length, int margin, int align, int* start
 }
 
 GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
-  int min_col = mask.Width(), max_col = -1, min_row = mask.Height(), max_row = -1;
-  for (int row = 0; row < mask.Height(); ++row) {
-    for (int col = 0; col < mask.Width(); ++col) {
-      if (mask.At(row, col) <= 0.5f) continue;
-      min_col = std::min(min_col, col);
-      max_col = std::max(max_col, col);
-      min_row = std::min(min_row, row);
-      max_row = std::max(max_row, row);
-    }
-  }
+  const PixelBox box = BoundingBoxAbove(mask, 0.5f);
   GridCrop crop;
-  if (max_col < 0) return crop;
-  CropAxis(min_col, max_col, mask.Width(), margin, align, &crop.x0, &crop.width);
-  CropAxis(min_row, max_row, mask.Height(), margin, align, &crop.y0, &crop.height);
+  if (box.Empty()) return crop;
+  CropAxis(box.x_begin, box.x_end - 1, mask.Width(), margin, align, &crop.x0, &crop.width);
+  CropAxis(box.y_begin, box.y_end - 1, mask.Height(), margin, align, &crop.y0, &crop.height);
   return crop;
 }
 
