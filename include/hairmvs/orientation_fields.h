@@ -36,7 +36,12 @@ struct OrientationFieldOptions {
   double sigma_across_inner_px = 1.0;
   double sigma_across_outer_px = 2.0;
   double sigma_along_px = 4.0;
-  // F = (max_theta |K_theta * I|)^gamma.
+  // F = (max_theta |K_theta * I|)^gamma: how much a strong strand outweighs a faint one (a
+  // shadowed strand further in) in the matching. Measured on d16f930 (the g2 group of
+  // synth_straight_gantry, `bash scripts/evaluate_stereo.sh ../shared/data/synth_straight_gantry
+  // OUT --image_names g2_b.png,g2_c.png,g2_l.png,g2_r.png --OrientationField.confidence_gamma
+  // G`; complete / per-pixel mean / median): 0.25 98.3% / 6.35 / 4.14 mm, 0.5 99.6% / 6.07 /
+  // 4.02, 1 99.7% / 6.27 / 4.09 mm; the depths' `layer` 33 / 31 / 33%.
   double confidence_gamma = 0.5;
   // The filter's support: the rectangle |along| <= t sigma_along, |across| <= t sigma_outer
   // (rotated with the filter); beyond 3 sigma the Gaussians are below 1.1% of their peak.
