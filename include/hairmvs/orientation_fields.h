@@ -37,7 +37,7 @@ struct OrientationFieldOptions {
   double sigma_across_outer_px = 2.0;
   double sigma_along_px = 4.0;
   // F = (max_theta |K_theta * I|)^gamma: how much a strong strand outweighs a faint one (a
-  // shadowed strand further in) in the matching. Measured on d16f930 (the g2 group of
+  // shadowed strand further in) in the matching. Measured on ebc0fb2 (the g2 group of
   // synth_straight_gantry, `bash scripts/evaluate_stereo.sh ../shared/data/synth_straight_gantry
   // OUT --image_names g2_b.png,g2_c.png,g2_l.png,g2_r.png --OrientationField.confidence_gamma
   // G`; complete / per-pixel mean / median): 0.25 98.3% / 6.35 / 4.14 mm, 0.5 99.6% / 6.07 /
