@@ -46,8 +46,13 @@ std::vector<FloatMap> ComputeOrientationFieldReference(const FloatMap& gray, con
 
 // Tunables of the OpenCL kernel (kernels/orientation.cl); the results do not depend on them
 // beyond floating-point rounding.
+// 8-pixel vectors measured faster than 16 on this 2-core machine through PoCL (2026-12-06,
+// alternating in one session): `hairmvs orientation_fields` on synth_straight_gantry's 32 views,
+// filter kernel 19.9 / 19.4 s against 21.9 / 21.6 s, the fields byte for byte the same;
+// `bench/orientation_benchmark` BM_OrientationFieldAllLevels (block 12, 4 x 4) median 3.91 s
+// against 4.43 s.
 struct OrientationKernelConfig {
-  int vector_width = 16;  // pixels per work-item (8 or 16): the float vector type
+  int vector_width = 8;   // pixels per work-item (8 or 16): the float vector type
   int block_size = 12;    // angles per pass: accumulators kept in registers per work-item
   int local_size_x = 4;   // work-group size (x in work-items, y in rows)
   int local_size_y = 4;

@@ -189,10 +189,10 @@ TEST_F(OrientationFieldTest, KernelMatchesCpuReferenceAtEveryLevel) {
                                                      options.confidence_gamma,
                                                      options.SignedResponseRatio(), &ref.responses);
       }
-      // The default configuration, and one with 8-pixel vectors, a block size that leaves a
+      // The default configuration, and one with 16-pixel vectors, a block size that leaves a
       // partial last block (180 = 25 * 7 + 5) and other work-group sizes.
       for (const OrientationKernelConfig& config :
-           {OrientationKernelConfig(), OrientationKernelConfig{8, 7, 2, 2}}) {
+           {OrientationKernelConfig(), OrientationKernelConfig{16, 7, 2, 2}}) {
         OrientationFieldComputer computer(context_, options, config);
         const std::vector<FloatMap> levels = computer.Compute(gray, mask);
         ASSERT_EQ(levels.size(), 3u);
