@@ -42,26 +42,27 @@ class FloatMap {
   std::vector<float> data_;
 };
 
-// The pixels [x_begin, x_end) x [y_begin, y_end) of a map.
+// The width x height pixels of a map whose top-left pixel is (x0, y0).
 struct PixelBox {
-  int x_begin = 0, y_begin = 0, x_end = 0, y_end = 0;
-  bool Empty() const { return x_end <= x_begin || y_end <= y_begin; }
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  bool Empty() const { return width <= 0 || height <= 0; }
 };
 
 // The smallest box holding every pixel whose channel 0 is above `threshold` (empty if none).
 inline PixelBox BoundingBoxAbove(const FloatMap& map, float threshold) {
-  PixelBox box{map.Width(), map.Height(), 0, 0};
+  int min_col = map.Width(), max_col = -1, min_row = map.Height(), max_row = -1;
   for (int row = 0; row < map.Height(); ++row) {
     const float* values = map.Channel(0) + static_cast<size_t>(row) * map.Width();
     for (int col = 0; col < map.Width(); ++col) {
       if (!(values[col] > threshold)) continue;
-      box.x_begin = std::min(box.x_begin, col);
-      box.x_end = std::max(box.x_end, col + 1);
-      box.y_begin = std::min(box.y_begin, row);
-      box.y_end = row + 1;
+      min_col = std::min(min_col, col);
+      max_col = std::max(max_col, col);
+      min_row = std::min(min_row, row);
+      max_row = row;
     }
   }
-  return box.Empty() ? PixelBox() : box;
+  if (max_col < 0) return PixelBox();
+  return PixelBox{min_col, min_row, max_col - min_col + 1, max_row - min_row + 1};
 }
 
 // The width x height part of `map` whose top-left pixel is (x0, y0), all channels; it must lie

@@ -41,5 +41,24 @@ TEST(FloatMap, CropAndPasteKeepEveryChannelInPlace) {
   }
 }
 
+TEST(FloatMap, BoundingBoxAboveHoldsExactlyThePixelsAboveTheThreshold) {
+  FloatMap mask(9, 6, 1, 0.0f);
+  mask.At(1, 3) = 1.0f;
+  mask.At(4, 7) = 0.6f;
+  mask.At(2, 1) = 0.4f;  // above 0 but not above 0.5
+  const PixelBox half = BoundingBoxAbove(mask, 0.5f);
+  EXPECT_EQ(half.x0, 3);
+  EXPECT_EQ(half.y0, 1);
+  EXPECT_EQ(half.width, 5);
+  EXPECT_EQ(half.height, 4);
+  const PixelBox any = BoundingBoxAbove(mask, 0.0f);
+  EXPECT_EQ(any.x0, 1);
+  EXPECT_EQ(any.y0, 1);
+  EXPECT_EQ(any.width, 7);
+  EXPECT_EQ(any.height, 4);
+  EXPECT_TRUE(BoundingBoxAbove(mask, 1.0f).Empty());
+  EXPECT_TRUE(BoundingBoxAbove(FloatMap(), 0.0f).Empty());
+}
+
 }  // namespace
 }  // namespace hairmvs

@@ -179,10 +179,9 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
   if (box.Empty()) return out;
   const int vec = config_.vector_width;
   const int pad = bank_.Radius();
-  const int box_w = box.x_end - box.x_begin, box_h = box.y_end - box.y_begin;
-  const int out_stride = static_cast<int>(RoundUpToMultiple(box_w, vec));
+  const int out_stride = static_cast<int>(RoundUpToMultiple(box.width, vec));
   const int padded_stride = out_stride + 2 * pad;
-  const int padded_rows = box_h + 2 * pad;
+  const int padded_rows = box.height + 2 * pad;
 
   {
     ScopedStageTimer timer(timings_, "upload");
@@ -192,21 +191,20 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     s.padded_host.resize(static_cast<size_t>(padded_stride) * padded_rows);
     for (int r = 0; r < padded_rows; ++r) {
       const float* src = gray.Channel(0) +
-                         static_cast<size_t>(std::clamp(box.y_begin + r - pad, 0, h - 1)) * w;
+                         static_cast<size_t>(std::clamp(box.y0 + r - pad, 0, h - 1)) * w;
       float* dst = s.padded_host.data() + static_cast<size_t>(r) * padded_stride;
       for (int c = 0; c < padded_stride; ++c) {
-        dst[c] = src[std::clamp(box.x_begin + c - pad, 0, w - 1)];
+        dst[c] = src[std::clamp(box.x0 + c - pad, 0, w - 1)];
       }
     }
-    s.mask_host.assign(static_cast<size_t>(out_stride) * box_h, 0.0f);
-    for (int r = 0; r < box_h; ++r) {
+    s.mask_host.assign(static_cast<size_t>(out_stride) * box.height, 0.0f);
+    for (int r = 0; r < box.height; ++r) {
       float* dst = s.mask_host.data() + static_cast<size_t>(r) * out_stride;
       if (mask.Empty()) {
-        std::fill(dst, dst + box_w, 1.0f);
+        std::fill(dst, dst + box.width, 1.0f);
       } else {
-        const float* src =
-            mask.Channel(0) + static_cast<size_t>(box.y_begin + r) * w + box.x_begin;
-        std::copy(src, src + box_w, dst);
+        const float* src = mask.Channel(0) + static_cast<size_t>(box.y0 + r) * w + box.x0;
+        std::copy(src, src + box.width, dst);
       }
     }
     const size_t padded_bytes = s.padded_host.size() * sizeof(float);
@@ -251,28 +249,29 @@ FloatMap OrientationFieldComputer::ComputeLevel(const FloatMap& gray, const Floa
     k.setArg(arg++, s.out);
     k.setArg(arg++, blocked_.num_blocks);
     k.setArg(arg++, blocked_.num_orientations);
-    k.setArg(arg++, box_w);
-    k.setArg(arg++, box_h);
+    k.setArg(arg++, box.width);
+    k.setArg(arg++, box.height);
     k.setArg(arg++, out_stride);
     k.setArg(arg++, static_cast<float>(options_.confidence_gamma));
     k.setArg(arg++, static_cast<float>(options_.SignedResponseRatio()));
     const cl::NDRange local(config_.local_size_x, config_.local_size_y);
     const cl::NDRange global(RoundUpToMultiple(out_stride / vec, config_.local_size_x),
-                             RoundUpToMultiple(box_h, config_.local_size_y));
+                             RoundUpToMultiple(box.height, config_.local_size_y));
     queue.enqueueNDRangeKernel(k, cl::NullRange, global, local);
     queue.finish();
   }
 
   {
     ScopedStageTimer timer(timings_, "download");
-    s.out_host.resize(2 * static_cast<size_t>(out_stride) * box_h);
+    s.out_host.resize(2 * static_cast<size_t>(out_stride) * box.height);
     queue.enqueueReadBuffer(s.out, CL_TRUE, 0, s.out_host.size() * sizeof(float),
                             s.out_host.data());
     for (int c = 0; c < 2; ++c) {
-      for (int r = 0; r < box_h; ++r) {
-        const float* src = s.out_host.data() + (static_cast<size_t>(c) * box_h + r) * out_stride;
-        std::copy(src, src + box_w,
-                  out.Channel(c) + static_cast<size_t>(box.y_begin + r) * w + box.x_begin);
+      for (int r = 0; r < box.height; ++r) {
+        const float* src =
+            s.out_host.data() + (static_cast<size_t>(c) * box.height + r) * out_stride;
+        std::copy(src, src + box.width,
+                  out.Channel(c) + static_cast<size_t>(box.y0 + r) * w + box.x0);
       }
     }
   }

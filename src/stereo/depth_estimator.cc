@@ -689,10 +689,6 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
 // (moved back from the image's edge if need be): PoCL runs a kernel in work-groups whose size
 // divides the global size, and sizes with few factors of 2 leave it small groups, which it
 // vectorises less well. Empty (width 0) when the mask has no pixel.
-struct GridCrop {
-  int x0 = 0, y0 = 0, width = 0, height = 0;
-};
-
 constexpr int kCropSizeMultiple = 32;
 
 // [start, start + size) along an axis of `length` px holding [first, last] grown by margin.
@@ -709,18 +705,19 @@ void CropAxis(int first, int last, int length, int margin, int align, int* start
   }
 }
 
-GridCrop MaskCrop(const FloatMap& mask, int margin, int align) {
+PixelBox MaskCrop(const FloatMap& mask, int margin, int align) {
   const PixelBox box = BoundingBoxAbove(mask, 0.5f);
-  GridCrop crop;
+  PixelBox crop;
   if (box.Empty()) return crop;
-  CropAxis(box.x_begin, box.x_end - 1, mask.Width(), margin, align, &crop.x0, &crop.width);
-  CropAxis(box.y_begin, box.y_end - 1, mask.Height(), margin, align, &crop.y0, &crop.height);
+  CropAxis(box.x0, box.x0 + box.width - 1, mask.Width(), margin, align, &crop.x0, &crop.width);
+  CropAxis(box.y0, box.y0 + box.height - 1, mask.Height(), margin, align, &crop.y0,
+           &crop.height);
   return crop;
 }
 
 // Level `level` of a pyramid (orientation fields or colours) cropped as `crop` is at level 0,
 // to the size of that level of the cropped camera `part`.
-FloatMap CropLevel(const FloatMap& map, const GridCrop& crop, const StereoCamera& part,
+FloatMap CropLevel(const FloatMap& map, const PixelBox& crop, const StereoCamera& part,
                    int level) {
   const StereoCamera grid = part.PyramidLevel(level);
   const int x0 = crop.x0 >> level, y0 = crop.y0 >> level;
@@ -755,7 +752,7 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
   for (size_t l = 0; l < std::min<size_t>(num_pyramid_levels, options.num_levels); ++l) {
     reach = std::max(reach, (options.WindowPx(static_cast<int>(l)) / 2 + 1) << l);
   }
-  const GridCrop crop = MaskCrop(mask, 2 * reach, 1 << (num_pyramid_levels - 1));
+  const PixelBox crop = MaskCrop(mask, 2 * reach, 1 << (num_pyramid_levels - 1));
   if (crop.width == 0 || (crop.width == width0 && crop.height == height0)) return whole_grid();
 
   StereoViewData part;
