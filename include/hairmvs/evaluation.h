@@ -96,6 +96,13 @@ struct DepthEvaluationOptions {
   // the window's median, the README's ideal smooth surface. Below 50% the depths follow the
   // front of the hair, above it the strands behind. 0: not computed.
   int layer_window_px = 7;
+  // The per-pixel error split by scale: its smooth part, the signed errors averaged over a k x k
+  // window of the map (k = this; the hair pixels with a depth), is what a surface wrong at that
+  // scale errs by, and the rest (each error less that average) what a surface right at that
+  // scale would still err by: the hair's layering, which only a depth per strand follows, and
+  // the map's own finer errors. The medians of both are reported. 31 px: about the reach of the
+  // coarsest level's aggregation window at 960 x 640. 0: not computed.
+  int smooth_error_window_px = 31;
   // Where a depth is compared with the truth. On: each depth is back-projected with the
   // workspace's camera and projected into the view's true camera (gt/cameras.npz), and is
   // compared, as a z-depth in that camera, with the truth of the true pixel it lands in (its
@@ -126,6 +133,8 @@ struct DepthEvaluationOptions {
       "hair pixels this close to the background count as near the silhouette (px)");
     v("layer_window_px", &layer_window_px,
       "k x k window (odd) of true depths that ranks the layer of each depth (0 = off)");
+    v("smooth_error_window_px", &smooth_error_window_px,
+      "k x k window (odd) whose mean signed error is the smooth part of the error (0 = off)");
     v("in_true_cameras", &in_true_cameras,
       "compare each depth in the true camera's pixel it projects to (1) or at the pixel of "
       "the same index (0)");
@@ -158,6 +167,10 @@ struct DepthMetrics {
   // true depths around a pixel in front of its depth, 0.5 = the local median of the truth.
   long num_layer_pixels = 0;
   double median_layer = 0;
+  // Medians of |smooth part| and |rest| of the per-pixel error
+  // (DepthEvaluationOptions::smooth_error_window_px); 0 when not computed.
+  double smooth_median_abs_error_mm = 0;
+  double rough_median_abs_error_mm = 0;
   // 3D: back-projected with the workspace's camera, distance to the nearest true strand.
   long num_points_3d = 0;
   double accuracy_3d_mean_mm = 0;

@@ -33,13 +33,17 @@ struct DepthSamples {
   std::vector<double> silhouette_errors_m, interior_errors_m;
   std::vector<double> distances_3d_m;  // a subset of them, back-projected
   std::vector<double> layers;          // of the pixels whose true depth window is all hair
+  // The signed errors' smooth part and the rest (DepthEvaluationOptions::smooth_error_window_px).
+  std::vector<double> smooth_errors_m, rough_errors_m;
 
   void Append(const DepthSamples& other) {
     num_hair_pixels += other.num_hair_pixels;
     layers.insert(layers.end(), other.layers.begin(), other.layers.end());
     for (auto [to, from] : {std::pair(&silhouette_errors_m, &other.silhouette_errors_m),
                             std::pair(&interior_errors_m, &other.interior_errors_m),
-                            std::pair(&distances_3d_m, &other.distances_3d_m)}) {
+                            std::pair(&distances_3d_m, &other.distances_3d_m),
+                            std::pair(&smooth_errors_m, &other.smooth_errors_m),
+                            std::pair(&rough_errors_m, &other.rough_errors_m)}) {
       to->insert(to->end(), from->begin(), from->end());
     }
   }
@@ -66,6 +70,26 @@ double LayerInWindow(const GroundTruthView& gt, int r, int c, int k, double dept
     }
   }
   return in_front / (k * k);
+}
+
+// For each pixel of `has_depth` (255), the mean of `signed_errors` over the pixels of
+// `has_depth` in its k x k window (the smooth part) and its own error less that mean.
+void SplitErrorByScale(const cv::Mat& signed_errors, const cv::Mat& has_depth, int k,
+                       std::vector<double>* smooth_errors, std::vector<double>* rough_errors) {
+  cv::Mat weights, error_sums, weight_sums;
+  has_depth.convertTo(weights, CV_64FC1, 1.0 / 255);
+  const cv::Size window(k, k);
+  const cv::Point centre(-1, -1);
+  cv::boxFilter(signed_errors, error_sums, -1, window, centre, false, cv::BORDER_CONSTANT);
+  cv::boxFilter(weights, weight_sums, -1, window, centre, false, cv::BORDER_CONSTANT);
+  for (int r = 0; r < signed_errors.rows; ++r) {
+    for (int c = 0; c < signed_errors.cols; ++c) {
+      if (!has_depth.at<uint8_t>(r, c)) continue;
+      const double smooth = error_sums.at<double>(r, c) / weight_sums.at<double>(r, c);
+      smooth_errors->push_back(smooth);
+      rough_errors->push_back(signed_errors.at<double>(r, c) - smooth);
+    }
+  }
 }
 
 DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
@@ -100,6 +124,8 @@ DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   m.interior_median_signed_error_mm = MedianMm(samples.interior_errors_m);
   m.num_layer_pixels = static_cast<long>(samples.layers.size());
   m.median_layer = Percentile(samples.layers, 0.5);
+  m.smooth_median_abs_error_mm = MedianMm(Absolute(samples.smooth_errors_m));
+  m.rough_median_abs_error_mm = MedianMm(Absolute(samples.rough_errors_m));
   const DistanceStats accuracy = SummarizeDistances(samples.distances_3d_m);
   m.num_points_3d = accuracy.count;
   m.accuracy_3d_mean_mm = accuracy.mean_mm;
@@ -126,6 +152,8 @@ nlohmann::json ToJson(const DepthMetrics& m) {
           {"interior_median_signed_error_mm", m.interior_median_signed_error_mm},
           {"num_layer_pixels", m.num_layer_pixels},
           {"median_layer", m.median_layer},
+          {"smooth_median_abs_error_mm", m.smooth_median_abs_error_mm},
+          {"rough_median_abs_error_mm", m.rough_median_abs_error_mm},
           {"num_points_3d", m.num_points_3d},
           {"accuracy_3d_mean_mm", m.accuracy_3d_mean_mm},
           {"accuracy_3d_median_mm", m.accuracy_3d_median_mm},
@@ -136,14 +164,14 @@ std::string TableRow(const DepthMetrics& m) {
   char line[256];
   std::snprintf(line, sizeof(line),
                 "%-14s %9ld %7.1f%% %8.2f %8.2f %6.1f%% %6.1f%% %6.1f%% %8.3f %8.3f %7.2f"
-                " %6.1f%% %7.2f %7.2f %7.2f %7.2f %5.0f%%\n",
+                " %6.1f%% %7.2f %7.2f %7.2f %7.2f %5.0f%% %7.2f %7.2f\n",
                 m.name.c_str(), m.num_hair_pixels, 100 * m.completeness, m.mean_abs_error_mm,
                 m.median_abs_error_mm, 100 * m.within_1mm, 100 * m.within_2mm,
                 100 * m.within_5mm, m.accuracy_3d_mean_mm, m.accuracy_3d_median_mm,
                 m.median_signed_error_mm, 100 * m.silhouette_fraction,
                 m.silhouette_median_abs_error_mm, m.silhouette_median_signed_error_mm,
                 m.interior_median_abs_error_mm, m.interior_median_signed_error_mm,
-                100 * m.median_layer);
+                100 * m.median_layer, m.smooth_median_abs_error_mm, m.rough_median_abs_error_mm);
   return line;
 }
 
@@ -170,6 +198,11 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
     *error = "--layer_window_px must be 0 or odd";
     return false;
   }
+  if (smooth_error_window_px < 0 ||
+      (smooth_error_window_px > 0 && smooth_error_window_px % 2 == 0)) {
+    *error = "--smooth_error_window_px must be 0 or odd";
+    return false;
+  }
   if (!(strand_spacing_m > 0)) {
     *error = "--strand_spacing_m must be > 0";
     return false;
@@ -180,10 +213,11 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
 std::string DepthEvaluationResult::Table() const {
   // sil = hair pixels within silhouette_band_px of the background, int = the others;
   // signed medians (sgn) > 0: behind the truth; layer: median fraction of the true depths
-  // around a pixel in front of its depth (50% = their median).
+  // around a pixel in front of its depth (50% = their median); smooth / rough: the medians of
+  // the error's part that is smooth over smooth_error_window_px and of the rest.
   return EvaluationTable(
       "view           hair_px  complete  mean_mm  med_mm  <=1mm  <=2mm  <=5mm  3d_mean  "
-      "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn  layer\n",
+      "3d_med  sgn_mm    sil% sil_med sil_sgn int_med int_sgn  layer  smooth   rough\n",
       views, overall, json_path, TableRow);
 }
 
@@ -267,6 +301,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     cv::Mat levels(height, width, CV_8UC1, cv::Scalar(0));
     cv::Mat signed_levels(height, width, CV_32FC1, cv::Scalar(0));
     cv::Mat has_depth(height, width, CV_8UC1, cv::Scalar(0));
+    cv::Mat signed_errors(height, width, CV_64FC1, cv::Scalar(0));
     for (int r = 0; r < height; ++r) {
       const int same_row = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
       for (int c = 0; c < width; ++c) {
@@ -309,6 +344,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         signed_levels.at<float>(r, c) = static_cast<float>(
             std::clamp(1e3 * signed_error / options.error_image_max_mm, -1.0, 1.0));
         has_depth.at<uint8_t>(r, c) = 255;
+        signed_errors.at<double>(r, c) = signed_error;
         points.push_back(world);
       }
     }
@@ -316,6 +352,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
         points.size() > static_cast<size_t>(options.max_points_3d_per_view)) {
       std::shuffle(points.begin(), points.end(), rng);
       points.resize(options.max_points_3d_per_view);
+    }
+    if (options.smooth_error_window_px > 0) {
+      SplitErrorByScale(signed_errors, has_depth, options.smooth_error_window_px,
+                        &samples.smooth_errors_m, &samples.rough_errors_m);
     }
     laps.Lap("per-pixel errors");
     progress.Stage("3D distances");

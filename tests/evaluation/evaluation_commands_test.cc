@@ -287,6 +287,59 @@ TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
   EXPECT_NE(error.find("silhouette_band_px"), std::string::npos) << error;
 }
 
+// v0's depths 2 mm behind the truth plus a checkerboard of +-1 mm: over a 5 x 5 window the
+// checkerboard averages to +-0.04 mm (13 squares of one sign, 12 of the other), so the smooth
+// part is 2 mm and the rest 1 mm, up to that and the partial windows at the hair's edges.
+TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
+  const Scene scene = MakeScene("smooth_error");
+  const std::string out = JoinPaths(scene.dir, "shifted");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v0.png");
+  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
+  const FloatMap exact = ReadMat(v0);
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v0.png"};
+  options.write_error_images = false;
+  options.smooth_error_window_px = 5;
+  auto evaluate_with_checkerboard = [&](float checker_m) {
+    FloatMap depth = exact;
+    for (int r = 0; r < kHeight; ++r) {
+      for (int c = 0; c < kWidth; ++c) {
+        if (truth.label[r * kWidth + c] != kLabelHair) continue;
+        depth.At(r, c) += 2e-3f + ((r + c) % 2 == 0 ? checker_m : -checker_m);
+      }
+    }
+    WriteMat(v0, depth);
+    return EvaluateDepthMaps(out, scene.gt, options).overall;
+  };
+  DepthMetrics m = evaluate_with_checkerboard(1e-3f);
+  EXPECT_NEAR(m.smooth_median_abs_error_mm, 2.0, 0.05);
+  EXPECT_NEAR(m.rough_median_abs_error_mm, 1.0, 0.05);
+  EXPECT_NEAR(m.median_abs_error_mm, 2.0, 1e-3);  // 1 or 3 mm, as many of each (+-1)
+  // A smooth error has no rest (float depths: 1e-4 mm).
+  m = evaluate_with_checkerboard(0.0f);
+  EXPECT_NEAR(m.smooth_median_abs_error_mm, 2.0, 1e-3);
+  EXPECT_NEAR(m.rough_median_abs_error_mm, 0.0, 1e-3);
+  // A 1 x 1 window: the smooth part is the error itself.
+  options.smooth_error_window_px = 1;
+  m = evaluate_with_checkerboard(1e-3f);
+  EXPECT_DOUBLE_EQ(m.smooth_median_abs_error_mm, m.median_abs_error_mm);
+  EXPECT_NEAR(m.rough_median_abs_error_mm, 0.0, 1e-9);
+  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, options);
+  EXPECT_NE(result.Table().find("smooth"), std::string::npos);
+  const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
+  EXPECT_NEAR(json["overall"]["rough_median_abs_error_mm"].get<double>(), 0.0, 1e-9);
+
+  options.smooth_error_window_px = 0;
+  m = EvaluateDepthMaps(out, scene.gt, options).overall;
+  EXPECT_EQ(m.smooth_median_abs_error_mm, 0.0);
+  EXPECT_EQ(m.rough_median_abs_error_mm, 0.0);
+  options.smooth_error_window_px = 4;
+  std::string error;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("smooth_error_window_px"), std::string::npos) << error;
+}
+
 // A workspace whose v1 is off its true pose, as a mapper's poses are: 5 mm nearer the hair
 // along its axis and turned 0.4 degrees (2.8 px here). import_ground_truth gives the true maps
 // their true poses back. The off-pose camera's own exact depths, compared at the true pixel of
