@@ -111,6 +111,27 @@ DepthEvaluationOptions FastDepthOptions() {
   return options;
 }
 
+// A scene's true maps imported into a new workspace, with one view's truth and the path of its
+// imported depth map, for tests that write that map again with errors of their own.
+struct ImportedView {
+  Scene scene;
+  std::string workspace;
+  GroundTruthView truth;
+  std::string depth_map_path;
+};
+
+ImportedView ImportView(const std::string& scene_name, const std::string& image_name) {
+  ImportedView imported;
+  imported.scene = MakeScene(scene_name);
+  imported.workspace = JoinPaths(imported.scene.dir, "imported");
+  ImportGroundTruth(imported.scene.gt, imported.scene.workspace, imported.workspace,
+                    ImportGroundTruthOptions());
+  imported.truth = ReadGroundTruthView(imported.scene.gt, image_name);
+  imported.depth_map_path =
+      JoinPaths(imported.workspace, "stereo", "depth_maps", image_name + ".geometric.bin");
+  return imported;
+}
+
 TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
   const Scene scene = MakeScene("truth");
   const std::string out = JoinPaths(scene.dir, "imported");
@@ -218,13 +239,13 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
 }
 
 TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
-  const Scene scene = MakeScene("silhouette");
-  const std::string out = JoinPaths(scene.dir, "shifted");
-  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
   // v0's depths 3 mm behind the truth within 4 px of the background, 1 mm in front further in;
   // the distance to the nearest background pixel by brute force.
-  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v0.png");
-  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
+  const ImportedView imported = ImportView("silhouette", "v0.png");
+  const Scene& scene = imported.scene;
+  const std::string& out = imported.workspace;
+  const GroundTruthView& truth = imported.truth;
+  const std::string& v0 = imported.depth_map_path;
   FloatMap depth = ReadMat(v0);
   long num_near = 0, num_hair = 0;
   for (int r = 0; r < kHeight; ++r) {
@@ -291,12 +312,8 @@ TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
 // checkerboard averages to +-0.04 mm (13 squares of one sign, 12 of the other), so the smooth
 // part is 2 mm and the rest 1 mm, up to that and the partial windows at the hair's edges.
 TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
-  const Scene scene = MakeScene("smooth_error");
-  const std::string out = JoinPaths(scene.dir, "shifted");
-  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
-  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v0.png");
-  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
-  const FloatMap exact = ReadMat(v0);
+  const ImportedView v0 = ImportView("smooth_error", "v0.png");
+  const FloatMap exact = ReadMat(v0.depth_map_path);
   DepthEvaluationOptions options = FastDepthOptions();
   options.image_names = {"v0.png"};
   options.write_error_images = false;
@@ -305,12 +322,12 @@ TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
     FloatMap depth = exact;
     for (int r = 0; r < kHeight; ++r) {
       for (int c = 0; c < kWidth; ++c) {
-        if (truth.label[r * kWidth + c] != kLabelHair) continue;
+        if (v0.truth.label[r * kWidth + c] != kLabelHair) continue;
         depth.At(r, c) += 2e-3f + ((r + c) % 2 == 0 ? checker_m : -checker_m);
       }
     }
-    WriteMat(v0, depth);
-    return EvaluateDepthMaps(out, scene.gt, options).overall;
+    WriteMat(v0.depth_map_path, depth);
+    return EvaluateDepthMaps(v0.workspace, v0.scene.gt, options).overall;
   };
   DepthMetrics m = evaluate_with_checkerboard(1e-3f);
   EXPECT_NEAR(m.smooth_median_abs_error_mm, 2.0, 0.05);
@@ -325,13 +342,13 @@ TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
   m = evaluate_with_checkerboard(1e-3f);
   EXPECT_DOUBLE_EQ(m.smooth_median_abs_error_mm, m.median_abs_error_mm);
   EXPECT_NEAR(m.rough_median_abs_error_mm, 0.0, 1e-9);
-  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, options);
+  const DepthEvaluationResult result = EvaluateDepthMaps(v0.workspace, v0.scene.gt, options);
   EXPECT_NE(result.Table().find("smooth"), std::string::npos);
   const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
   EXPECT_NEAR(json["overall"]["rough_median_abs_error_mm"].get<double>(), 0.0, 1e-9);
 
   options.smooth_error_window_px = 0;
-  m = EvaluateDepthMaps(out, scene.gt, options).overall;
+  m = EvaluateDepthMaps(v0.workspace, v0.scene.gt, options).overall;
   EXPECT_EQ(m.smooth_median_abs_error_mm, 0.0);
   EXPECT_EQ(m.rough_median_abs_error_mm, 0.0);
   options.smooth_error_window_px = 4;
@@ -470,12 +487,12 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
 }
 
 TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
-  const Scene scene = MakeScene("layer");
-  const std::string out = JoinPaths(scene.dir, "imported");
-  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
   // v1 sees the plane at a slant: its true depth grows by ~0.07 mm per column, so a 7 x 7
   // window holds three columns in front of its centre and three behind.
-  const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v1.png");
+  const ImportedView imported = ImportView("layer", "v1.png");
+  const Scene& scene = imported.scene;
+  const std::string& out = imported.workspace;
+  const GroundTruthView& truth = imported.truth;
   long num_full_windows = 0;
   for (int r = 3; r + 3 < kHeight; ++r) {
     for (int c = 3; c + 3 < kWidth; ++c) {
@@ -489,7 +506,7 @@ TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
     }
   }
   ASSERT_GT(num_full_windows, 500);
-  const std::string v1 = JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin");
+  const std::string& v1 = imported.depth_map_path;
   const FloatMap exact = ReadMat(v1);
   DepthEvaluationOptions options = FastDepthOptions();
   options.image_names = {"v1.png"};
