@@ -115,7 +115,11 @@ struct OrientationStereoOptions {
   // -2.21 against -2.35 mm), 97 s; the curly demo 98.0% / 3.44 / 2.28 / 0.326 / 0.259 against
   // 98.3% / 3.46 / 2.37 / 0.302 / 0.243; but synth_handheld, whose level-0 orientation cost is
   // weakest, 93.6% / 12.57 / 6.82 / 1.661 / 0.697 against 92.2% / 10.86 / 5.41 / 1.774 / 0.632
-  // (first estimates 13.2 mm). With 2: the g2 group 4.09 against 4.04 mm.
+  // (first estimates 13.2 mm). With 2: the g2 group 4.09 against 4.04 mm. The fine stage's
+  // data term alone with fewer levels (a prototype on a1ce4c7, the coarse stage keeping all
+  // three): level 0 only, weighted as 1.5 / 3 times its source weights, or levels 0 and 1: the
+  // g2 group 4.00 / 4.01 / 4.01 mm against 4.02 (smooth part over 31 px 2.97 / 2.99 / 3.00
+  // against 3.03 mm; evaluate_depth).
   int num_levels = 3;
   // Level 0's share of each source's orientation cost, by how far the source looks away from
   // the reference: (level0_weight_angle_deg / angle)^level0_weight_angle_power, clamped to
