@@ -90,9 +90,12 @@ struct OrientationStereoOptions {
   // hull (see-through hair), the penalty pushes the depth to the next minimum, often far behind
   // (synth_straight_gantry g5_r: per-pixel median 10.4 -> 23.9 mm), while filtering drops it.
   VisualHullBound visual_hull_depth_bound = VisualHullBound::kFilter;
+  // 1 / 4 mm instead of 2: the g2 group of synth_straight_gantry 4.03 / 4.02 against 4.02 mm
+  // (.geometric, measured on a1ce4c7 with scripts/evaluate_stereo.sh, as the next two).
   double visual_hull_tolerance_m = 0.002;
   // The other views' masks are dilated by this many pixels before carving the hull (range and
   // bound), so that mask edges and calibration errors of a pixel or two do not carve hair.
+  // 1 / 4 px: the g2 group 4.01 / 4.01 mm against 4.02.
   int visual_hull_mask_dilation_px = 2;
   // A point leaves the hull (range and bound) only when at least this many of the views that
   // see it have it outside their mask. 1: the strict hull, which one view with a wrong pose
@@ -281,6 +284,7 @@ struct OrientationStereoOptions {
   // 0.869 -> 0.789 mm; first estimates 16.75 -> 12.29 mm; synth_straight_gantry g2 group 4.18
   // -> 4.22 mm, g5 group 5.96 -> 5.91; the curly demo group 2.39 -> 2.36 mm.
   bool strand_plane_from_visual_hull = true;
+  // 60 / 80 degrees: the g2 group 4.02 / 4.04 mm against 4.02.
   double max_strand_plane_tilt_deg = 70;
   // Orientation cost: match locally normalised orientation fields, (O - mean) / std over a
   // (2 r + 1)^2 window at every level (0 = the paper's raw fields). Default 3: on
