@@ -298,8 +298,6 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     // signed picture its signed error (blue in front, white 0, red behind, saturated at
     // error_image_max_mm).
     cv::Mat error_image(height, width, CV_8UC3, cv::Scalar(0, 0, 0));
-    cv::Mat levels(height, width, CV_8UC1, cv::Scalar(0));
-    cv::Mat signed_levels(height, width, CV_32FC1, cv::Scalar(0));
     cv::Mat has_depth(height, width, CV_8UC1, cv::Scalar(0));
     cv::Mat signed_errors(height, width, CV_64FC1, cv::Scalar(0));
     for (int r = 0; r < height; ++r) {
@@ -338,11 +336,6 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
               LayerInWindow(gt, gr, gc, options.layer_window_px, compared_depth);
           if (layer >= 0) samples.layers.push_back(layer);
         }
-        const double abs_error = std::abs(signed_error);
-        const double level = std::min(1.0, 1e3 * abs_error / options.error_image_max_mm);
-        levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * level));
-        signed_levels.at<float>(r, c) = static_cast<float>(
-            std::clamp(1e3 * signed_error / options.error_image_max_mm, -1.0, 1.0));
         has_depth.at<uint8_t>(r, c) = 255;
         signed_errors.at<double>(r, c) = signed_error;
         points.push_back(world);
@@ -364,11 +357,19 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     laps.Lap("3D distances");
 
     if (options.write_error_images) {
+      // The errors on the colour scale: |error| in 0..255 for the colour map, the signed one in
+      // [-1, 1].
+      cv::Mat levels(height, width, CV_8UC1, cv::Scalar(0));
       cv::Mat signed_image = error_image.clone();
       for (int r = 0; r < height; ++r) {
         for (int c = 0; c < width; ++c) {
           if (!has_depth.at<uint8_t>(r, c)) continue;
-          const float level = signed_levels.at<float>(r, c);
+          const double signed_error = signed_errors.at<double>(r, c);
+          const double abs_level =
+              std::min(1.0, 1e3 * std::abs(signed_error) / options.error_image_max_mm);
+          levels.at<uint8_t>(r, c) = static_cast<uint8_t>(std::lround(255 * abs_level));
+          const auto level = static_cast<float>(
+              std::clamp(1e3 * signed_error / options.error_image_max_mm, -1.0, 1.0));
           const auto fade = static_cast<uint8_t>(std::lround(255 * (1 - std::abs(level))));
           signed_image.at<cv::Vec3b>(r, c) =  // BGR
               level > 0 ? cv::Vec3b(fade, fade, 255) : cv::Vec3b(255, fade, fade);
