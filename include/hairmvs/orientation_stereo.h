@@ -395,6 +395,12 @@ struct OrientationStereoOptions {
   // 98.5 / 98.8% at 4.57 / 4.58 mm (4.56 / 4.55 on the pixels both keep; the 0.5% added are
   // 38 mm off, so the mean goes 9.74 -> 9.89 and the 3D mean 1.53 -> 1.59 mm); the g2 group
   // 4.04 / 4.03 mm, the curly demo 98.0 / 98.3% at 2.36 / 2.37 mm.
+  // Near the silhouettes, where a view's own data term sees through the fringe and a view of
+  // another T group sees the same hair face on, the prior's weight times 1 + b within d px of
+  // the background (a prototype on 5014a50, not kept; groups 3 to 6 of synth_straight_gantry,
+  // 16 views, 97.5% / 11.46 / 4.67 mm with the defaults): b = 2 / 8 / 8 / 50 at d = 20 / 20 /
+  // 40 / 60: 4.65 / 4.65 / 4.62 / 4.63 mm, the silhouette band 8.88 -> 8.82 / 8.81 / 8.67 /
+  // 8.66 mm: the other views' maps see through the same fringe.
   double geom_prior_weight = 2.0;
   double geom_prior_max_error_px = 6.0;
   // Rounds of the geometric pass (with geom_prior_weight > 0), at most
