@@ -14,6 +14,7 @@
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
 #include "colmap_ext/reconstruction.h"
+#include "colmap_ext/workspace.h"
 #include "hairmvs/evaluation.h"
 #include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
@@ -127,8 +128,7 @@ ImportedView ImportView(const std::string& scene_name, const std::string& image_
   ImportGroundTruth(imported.scene.gt, imported.scene.workspace, imported.workspace,
                     ImportGroundTruthOptions());
   imported.truth = ReadGroundTruthView(imported.scene.gt, image_name);
-  imported.depth_map_path =
-      JoinPaths(imported.workspace, "stereo", "depth_maps", image_name + ".geometric.bin");
+  imported.depth_map_path = Workspace::Read(imported.workspace).DepthMapPath(image_name);
   return imported;
 }
 
