@@ -39,6 +39,14 @@ struct SourceViewOptions {
   // 1 / 3 views of other groups nearest in viewing direction (28-50 degrees; a cfg by hand):
   // 98.4% / 7.54 / 4.10 mm and 98.6% / 7.78 / 4.13 mm (complete / per-pixel mean / median)
   // against 98.7% / 7.93 / 4.17, in 299 / 399 s. Wider sources hardly help orientation.
+  // The g2 group alone (both passes, 99.6% / 6.07 / 4.02 mm with its T group; measured on
+  // c68eb65): each view with g7_c, g7_l and g7_b too (35-41 degrees away) 98.6% / 5.79 / 3.98
+  // mm, with g0_r and g5_l (50 degrees, beside the group) 97.2% / 5.79 / 3.93 mm. They take
+  // the silhouette band from 5.89 to 5.46 / 5.50 mm (signed +1.57 -> +0.62 / -0.05: the
+  // hanging ends no longer fall behind), but push the interior further to the front (signed
+  // -2.14 -> -2.46 / -2.41 mm): across a wider baseline more of the deeper first hits, seen
+  // through gaps in the reference, are hidden in the source. Alone, each of these wide sources
+  // fails (g2_c, one pass: 8-47 mm against 4.1 mm with g2_l or g2_r alone).
   int max_num_source_views = 6;
   // COLMAP's PatchMatchStereo.min_triangulation_angle: 75th percentile of the shared points'
   // triangulation angles must reach this.
