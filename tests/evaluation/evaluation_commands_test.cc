@@ -327,22 +327,22 @@ TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
       }
     }
     WriteMat(v0.depth_map_path, depth);
-    return EvaluateDepthMaps(v0.workspace, v0.scene.gt, options).overall;
+    return EvaluateDepthMaps(v0.workspace, v0.scene.gt, options);
   };
-  DepthMetrics m = evaluate_with_checkerboard(1e-3f);
+  DepthMetrics m = evaluate_with_checkerboard(1e-3f).overall;
   EXPECT_NEAR(m.smooth_median_abs_error_mm, 2.0, 0.05);
   EXPECT_NEAR(m.rough_median_abs_error_mm, 1.0, 0.05);
   EXPECT_NEAR(m.median_abs_error_mm, 2.0, 1e-3);  // 1 or 3 mm, as many of each (+-1)
   // A smooth error has no rest (float depths: 1e-4 mm).
-  m = evaluate_with_checkerboard(0.0f);
+  m = evaluate_with_checkerboard(0.0f).overall;
   EXPECT_NEAR(m.smooth_median_abs_error_mm, 2.0, 1e-3);
   EXPECT_NEAR(m.rough_median_abs_error_mm, 0.0, 1e-3);
   // A 1 x 1 window: the smooth part is the error itself.
   options.smooth_error_window_px = 1;
-  m = evaluate_with_checkerboard(1e-3f);
+  const DepthEvaluationResult result = evaluate_with_checkerboard(1e-3f);
+  m = result.overall;
   EXPECT_DOUBLE_EQ(m.smooth_median_abs_error_mm, m.median_abs_error_mm);
   EXPECT_NEAR(m.rough_median_abs_error_mm, 0.0, 1e-9);
-  const DepthEvaluationResult result = EvaluateDepthMaps(v0.workspace, v0.scene.gt, options);
   EXPECT_NE(result.Table().find("smooth"), std::string::npos);
   const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
   EXPECT_NEAR(json["overall"]["rough_median_abs_error_mm"].get<double>(), 0.0, 1e-9);
