@@ -81,10 +81,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   }();
   std::vector<std::string> names = run_options.image_names;
   if (names.empty()) names = workspace.ImageNames();
-  for (const auto& name : names) {
-    workspace.ImageIdx(name);  // throws for an unknown name
-    RequireWritableDir(ParentPath(workspace.OrientationMapPath(name, 0)), "orientation map folder");
-  }
+  for (const auto& name : names) workspace.ImageIdx(name);  // throws for an unknown name
 
   std::shared_ptr<OpenCLContext> context;
   std::unique_ptr<OrientationFieldComputer> computer;
@@ -94,6 +91,10 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     computer = std::make_unique<OrientationFieldComputer>(context, options);
   }
   computer->SetTimings(timings);
+  // Created once the device holds, so that a run refused for it leaves no empty folders.
+  for (const auto& name : names) {
+    RequireWritableDir(ParentPath(workspace.OrientationMapPath(name, 0)), "orientation map folder");
+  }
 
   OrientationFieldsResult result;
   result.num_levels = options.num_levels;

@@ -118,6 +118,17 @@ TEST(RunOrientationFields, WritesEveryLevelOfEveryImage) {
 TEST(RunOrientationFields, ImageSubsetAndErrors) {
   const std::string root = MakeWorkspace();
   OrientationFieldsRunOptions run_options;
+  // A device that does not exist is named, before any output folder is made.
+  run_options.opencl_device = "no-such-device";
+  try {
+    RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
+    FAIL() << "expected an error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--OpenCL.device 'no-such-device'"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_FALSE(ExistsDir(ParentPath(Workspace::Read(root).OrientationMapPath("b.png", 0))));
+  run_options.opencl_device = "";
   run_options.image_names = {"b.png"};
   const auto result = RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
   EXPECT_EQ(result.num_images, 1);
@@ -128,17 +139,8 @@ TEST(RunOrientationFields, ImageSubsetAndErrors) {
   run_options.image_names = {"missing.png"};
   EXPECT_THROW(RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr), Error);
   run_options.image_names = {};
-  run_options.opencl_device = "no-such-device";
-  try {
-    RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--OpenCL.device 'no-such-device'"), std::string::npos)
-        << e.what();
-  }
   OrientationFieldOptions bad;
   bad.num_levels = 0;
-  run_options.opencl_device = "";
   EXPECT_THROW(RunOrientationFields(root, bad, run_options, nullptr), Error);
   std::system(("rm -rf " + root).c_str());
 }

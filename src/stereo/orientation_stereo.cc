@@ -465,12 +465,6 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
   for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
   workspace.RequireUndistortedCameras();
-  // Outputs that cannot be written are found before minutes of work, not after.
-  for (const std::string& name : names) {
-    RequireWritableDir(ParentPath(workspace.DepthMapPath(name)), "depth map folder");
-    RequireWritableDir(ParentPath(workspace.NormalMapPath(name)), "normal map folder");
-    RequireWritableDir(ParentPath(workspace.ConfidenceMapPath(name)), "confidence map folder");
-  }
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
   if (workspace.MaskFolder().empty()) {
@@ -506,6 +500,14 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   const OrientationFieldOptions fields =
       field_options != nullptr ? *field_options : OrientationFieldOptions();
   THROW_IF(!fields.Check(&error), "invalid --OrientationField options: " << error);
+  // Outputs that cannot be written are found before minutes of work, not after; and only once
+  // the options, the sources and the device hold, so that a run refused for those leaves no
+  // empty folders in the workspace.
+  for (const std::string& name : names) {
+    RequireWritableDir(ParentPath(workspace.DepthMapPath(name)), "depth map folder");
+    RequireWritableDir(ParentPath(workspace.NormalMapPath(name)), "normal map folder");
+    RequireWritableDir(ParentPath(workspace.ConfidenceMapPath(name)), "confidence map folder");
+  }
   ViewLoader loader(workspace, options, fields, context, timings);
   OrientationStereoResult result;
   // The views this run computes (all of `names` but those skip_existing finds done), those it

@@ -698,7 +698,26 @@ TEST(OrientationStereoWorkspace, NoViewWithSourcesIsAnError) {
                        "share sparse points of sparse/)"),
             std::string::npos)
       << error;
+  // Refused before any output folder was made.
+  EXPECT_FALSE(ExistsDir(ParentPath(Workspace::Read(path).DepthMapPath("v0.png"))));
   EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, PlaneOptions(), nullptr).num_views, 0);
+  std::filesystem::remove_all(path);
+}
+
+// A device that does not exist is named, and the run leaves the workspace as it found it: no
+// empty output folders.
+TEST(OrientationStereoWorkspace, UnknownDeviceLeavesNoOutputFolders) {
+  const std::string path = MakeTestDir("stereo_no_device");
+  WriteWorkspace(path);
+  const std::string error = ErrorOf(
+      [&] { RunOrientationStereo(path, {}, PlaneOptions(), nullptr, "no-such-device"); });
+  EXPECT_NE(error.find("--OpenCL.device 'no-such-device'"), std::string::npos) << error;
+  const Workspace workspace = Workspace::Read(path);
+  for (const std::string& map_path :
+       {workspace.DepthMapPath("v0.png"), workspace.NormalMapPath("v0.png"),
+        workspace.ConfidenceMapPath("v0.png"), workspace.OrientationMapPath("v0.png", 0)}) {
+    EXPECT_FALSE(ExistsDir(ParentPath(map_path))) << map_path;
+  }
   std::filesystem::remove_all(path);
 }
 
