@@ -162,6 +162,12 @@ struct OrientationStereoOptions {
   // (The data term alone is the coarse stage's cheapest label per coarse pixel; on the coarse
   // pixels that are all hair, `evaluate_data_term --min_hair_fraction 1`, -1.59 mm with square
   // windows and +0.26 mm along the strand at level 0, at a median error of 4.43 / 6.83 mm.)
+  // The background in a window costs 0 at every label, so near the silhouettes the aggregated
+  // data term is weaker against the smoothness and the prior. Each level's aggregated cost
+  // divided by the same filter's response to the hair indicator (floored at 0.1 / 0.3; a
+  // prototype on af0af88, not kept) did not help: the g2 group 98.6% / 6.17 / 4.07 mm and
+  // 99.0% / 6.15 / 4.05 mm against 99.6% / 6.07 / 4.02, the silhouette band 6.09 / 5.98 mm
+  // against 5.89, the interior 2.96 mm either way.
   int window_px_level0 = 15;
   int window_px_level1 = 11;
   int window_px_level2 = 7;
