@@ -6,6 +6,9 @@
 #include <memory>
 #include <optional>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
 #include "src/core/logging.h"
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
@@ -109,27 +112,15 @@ MrfSolverOptions MakeMrfOptions(const OrientationStereoOptions& options) {
   return mrf;
 }
 
-// Window sums by a summed-area table (double, so long rows do not lose precision).
-void BoxSums(const float* in, int width, int height, int radius, std::vector<double>* sums,
-             std::vector<double>* table) {
-  const int w1 = width + 1;
-  table->assign(static_cast<size_t>(w1) * (height + 1), 0.0);
-  for (int r = 0; r < height; ++r) {
-    double row_sum = 0;
-    for (int c = 0; c < width; ++c) {
-      row_sum += in[r * width + c];
-      (*table)[(r + 1) * w1 + c + 1] = (*table)[r * w1 + c + 1] + row_sum;
-    }
-  }
-  sums->resize(static_cast<size_t>(width) * height);
-  for (int r = 0; r < height; ++r) {
-    const int r0 = std::max(0, r - radius), r1 = std::min(height, r + radius + 1);
-    for (int c = 0; c < width; ++c) {
-      const int c0 = std::max(0, c - radius), c1 = std::min(width, c + radius + 1);
-      (*sums)[r * width + c] = (*table)[r1 * w1 + c1] - (*table)[r0 * w1 + c1] -
-                               (*table)[r1 * w1 + c0] + (*table)[r0 * w1 + c0];
-    }
-  }
+// Sums over the (2 radius + 1)^2 window of each pixel, clipped at the image's edges, in double
+// so that the means taken from them keep a float field's precision.
+cv::Mat WindowSums(const float* in, int width, int height, int radius) {
+  cv::Mat sums;
+  cv::Mat(height, width, CV_32FC1, const_cast<float*>(in)).convertTo(sums, CV_64FC1);
+  const int size = 2 * radius + 1;
+  cv::boxFilter(sums, sums, -1, cv::Size(size, size), cv::Point(-1, -1), /*normalize=*/false,
+                cv::BORDER_CONSTANT);
+  return sums;
 }
 
 // Labels v = base(p) + k * step in front of the pixel's bound label get the pixel's worst cost
@@ -252,11 +243,14 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
   // eps in units of the field's own mean |O|^2, so that the confidence's exponent and the
   // images' contrast do not change what it damps.
   const double eps = relative_eps * MeanSquareOfNonZero(orientation);
-  std::vector<double> count, sum_re, sum_im, sum_sq, table;
-  BoxSums(valid.data(), width, height, radius, &count, &table);
-  BoxSums(orientation.Channel(0), width, height, radius, &sum_re, &table);
-  BoxSums(orientation.Channel(1), width, height, radius, &sum_im, &table);
-  BoxSums(sq.data(), width, height, radius, &sum_sq, &table);
+  const cv::Mat counts = WindowSums(valid.data(), width, height, radius);
+  const cv::Mat sums_re = WindowSums(orientation.Channel(0), width, height, radius);
+  const cv::Mat sums_im = WindowSums(orientation.Channel(1), width, height, radius);
+  const cv::Mat sums_sq = WindowSums(sq.data(), width, height, radius);
+  const auto* count = counts.ptr<double>();
+  const auto* sum_re = sums_re.ptr<double>();
+  const auto* sum_im = sums_im.ptr<double>();
+  const auto* sum_sq = sums_sq.ptr<double>();
   FloatMap out(width, height, 2, 0.0f);
   for (size_t i = 0; i < n; ++i) {
     if (valid[i] == 0.0f || count[i] < 1) continue;
