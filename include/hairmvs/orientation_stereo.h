@@ -124,7 +124,11 @@ struct OrientationStereoOptions {
   // data term alone with fewer levels (a prototype on a1ce4c7, the coarse stage keeping all
   // three): level 0 only, weighted as 1.5 / 3 times its source weights, or levels 0 and 1: the
   // g2 group 4.00 / 4.01 / 4.01 mm against 4.02 (smooth part over 31 px 2.97 / 2.99 / 3.00
-  // against 3.03 mm; evaluate_depth).
+  // against 3.03 mm; evaluate_depth). Level 0 alone where the hair is dense and all three
+  // levels where it thins out (measured on c5d4290 as an upper bound, not kept: the g2 group's
+  // .geometric maps of both runs merged per pixel by the mask's hair fraction in a 15 x 15 /
+  // 31 x 31 px window, >= 0.5 / 0.8 / 0.95 taking num_levels 1): 3.87-3.89 mm against 3.89
+  // (num_levels 1) and 4.02 (3); the silhouette band 6.02-6.21 mm against 6.21 and 5.89.
   int num_levels = 3;
   // Level 0's share of each source's orientation cost, by how far the source looks away from
   // the reference: (level0_weight_angle_deg / angle)^level0_weight_angle_power, clamped to
