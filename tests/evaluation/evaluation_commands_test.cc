@@ -140,12 +140,13 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
       ImportGroundTruth(scene.gt, scene.workspace, out, import_options);
   EXPECT_EQ(imported.num_views, 2);
   EXPECT_TRUE(std::filesystem::is_symlink(JoinPaths(out, "images")));
-  const FloatMap depth = ReadMat(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"));
+  const Workspace workspace = Workspace::Read(out);
+  const std::string v1 = workspace.DepthMapPath("v1.png");
+  const FloatMap depth = ReadMat(v1);
   const GroundTruthView truth = ReadGroundTruthView(scene.gt, "v1.png");
   EXPECT_EQ(depth.Data(), truth.depth.Data());
   // Normals of the plane z = 0.5 in camera 1's frame: R * (0, 0, -1).
-  const FloatMap normals =
-      ReadMat(JoinPaths(out, "stereo", "normal_maps", "v1.png.geometric.bin"));
+  const FloatMap normals = ReadMat(workspace.NormalMapPath("v1.png"));
   const Eigen::Vector3d expected = scene.cameras.R[1] * Eigen::Vector3d(0, 0, -1);
   const int r = kHeight / 2, c = kWidth / 2;
   ASSERT_GT(depth.At(r, c), 0);
@@ -170,12 +171,12 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
 
   // A view without its map is named as left out of the overall figures; a view asked for that
   // the workspace lacks is an error, not a missing file.
-  std::filesystem::remove(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"));
+  std::filesystem::remove(v1);
   ::testing::internal::CaptureStderr();
   EXPECT_EQ(EvaluateDepthMaps(out, scene.gt, FastDepthOptions()).views.size(), 1u);
   const std::string log = ::testing::internal::GetCapturedStderr();
   EXPECT_NE(log.find("1 of 2 views are not evaluated, for want of their file (e.g. " +
-                     JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin") + "): v1.png"),
+                     v1 + "): v1.png"),
             std::string::npos)
       << log;
   DepthEvaluationOptions unknown = FastDepthOptions();
@@ -192,7 +193,7 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
   import_options.seed = 3;
   ImportGroundTruth(scene.gt, scene.workspace, out, import_options);
   // Knock out every other row of v0: completeness 50%.
-  const std::string v0 = JoinPaths(out, "stereo", "depth_maps", "v0.png.geometric.bin");
+  const std::string v0 = Workspace::Read(out).DepthMapPath("v0.png");
   FloatMap depth = ReadMat(v0);
   for (int r = 0; r < kHeight; r += 2) {
     for (int c = 0; c < kWidth; ++c) depth.At(r, c) = 0;
@@ -225,7 +226,7 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
       if (std::abs(X.x()) <= kHairHalfX && std::abs(X.y()) <= kHairHalfY) half.At(r, c) = X.z();
     }
   }
-  WriteMat(JoinPaths(out2, "stereo", "depth_maps", "v0.png.geometric.bin"), half);
+  WriteMat(Workspace::Read(out2).DepthMapPath("v0.png"), half);
   DepthEvaluationOptions options = FastDepthOptions();
   options.image_names = {"v0.png"};
   const DepthEvaluationResult half_result = EvaluateDepthMaps(out2, scene.gt, options);
@@ -404,7 +405,7 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
       depth.At(r, c) = static_cast<float>((R * X + t).z());
     }
   }
-  WriteMat(JoinPaths(out, "stereo", "depth_maps", "v1.png.geometric.bin"), depth);
+  WriteMat(Workspace::Read(out).DepthMapPath("v1.png"), depth);
   options.in_true_cameras = true;
   const DepthMetrics in_true = EvaluateDepthMaps(out, scene.gt, options).overall;
   // The truth is sampled at the centre of the true pixel a point lands in: within half a
