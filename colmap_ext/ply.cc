@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -109,7 +110,14 @@ PlyHeader ReadPlyHeader(std::istream& in, const std::string& source) {
       have_format = true;
     } else if (keyword == "element") {
       PlyElement element;
-      THROW_IF(!(ss >> element.name >> element.count), where << ": malformed element line");
+      std::string count;
+      THROW_IF(!(ss >> element.name >> count), where << ": malformed element line");
+      // Parsed strictly: `>>` into an unsigned count would take "-1" as 2^64 - 1.
+      const char* count_end = count.data() + count.size();
+      const auto parsed = std::from_chars(count.data(), count_end, element.count);
+      THROW_IF(parsed.ec != std::errc() || parsed.ptr != count_end,
+               where << ": element '" << element.name << "' has no valid count ('" << count
+                     << "')");
       header.elements.push_back(element);
     } else if (keyword == "property") {
       THROW_IF(header.elements.empty(), where << ": property before any element");
@@ -194,6 +202,9 @@ void ReadPlyBody(std::istream& in, const PlyHeader& header, const std::string& s
                  const RowCallback& on_row) {
   PlyValueReader reader(in, header.format, source);
   for (const PlyElement& element : header.elements) {
+    // An element without properties has no data: its rows, however many, take no bytes (and
+    // counting through 2^64 of them would not end).
+    if (element.properties.empty()) continue;
     std::vector<double> scalars(element.properties.size(), 0.0);
     std::vector<std::vector<double>> lists(element.properties.size());
     for (uint64_t row = 0; row < element.count; ++row) {

@@ -188,5 +188,23 @@ TEST(MeshPly, ReadsAsciiDelaunayStyleAndQuads) {
   EXPECT_THROW(ReadMeshPly(bad, "bad.ply"), Error);  // face refers to missing vertices
 }
 
+// An element's count is a whole number; one without properties holds no data, however many
+// rows it claims (reading them one by one would not end).
+TEST(MeshPly, ElementCountsAreCheckedAndEmptyElementsSkipped) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nelement face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "end_header\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n";
+  for (const char* count : {"-1", "3x", "1e3", "99999999999999999999999"}) {
+    std::istringstream in(head + "element junk " + count + "\n" + body);
+    const std::string error = testing_util::ErrorOf([&] { ReadMeshPly(in, "j.ply"); });
+    EXPECT_NE(error.find("j.ply: PLY header line 9: element 'junk' has no valid count"),
+              std::string::npos)
+        << error;
+  }
+  std::istringstream empty_element(head + "element junk 18446744073709551615\n" + body);
+  EXPECT_EQ(ReadMeshPly(empty_element, "j.ply").faces.size(), 1u);
+}
+
 }  // namespace
 }  // namespace hairmvs
