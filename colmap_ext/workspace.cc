@@ -185,20 +185,45 @@ std::string Workspace::OrientationMapProvenancePath(const std::string& name) con
 
 namespace {
 
-// Whether a JPEG stream's end-of-image marker follows its last start-of-scan marker. libjpeg
-// decodes a truncated file without an error, filling what is missing with grey (OpenCV only
-// prints "Premature end of JPEG file"). Neither marker occurs inside entropy-coded data (0xFF
-// is stuffed there), and an embedded EXIF thumbnail's markers come before the main image's,
-// so the last of each belongs to the main image; bytes a camera appends after it are allowed.
+// Whether a JPEG stream reaches its end-of-image marker. libjpeg decodes a truncated file
+// without an error, filling what is missing with grey (OpenCV only prints "Premature end of
+// JPEG file"). The walk follows the stream's own structure from the start-of-image marker:
+// length-prefixed segments (an EXIF thumbnail lies inside one) are skipped whole, each scan's
+// entropy-coded data runs to the next marker that is not a restart marker (0xFF is stuffed as
+// FF 00 there), and the first end-of-image marker at the top level ends the image. Bytes a
+// camera appends after it (a motion photo's video, a maker trailer) are never read, whatever
+// markers they hold.
 bool JpegIsComplete(const std::string& bytes) {
-  size_t last_scan = std::string::npos, last_end = std::string::npos;
-  for (size_t i = 0; i + 1 < bytes.size(); ++i) {
-    if (static_cast<uint8_t>(bytes[i]) != 0xFF) continue;
-    const uint8_t marker = static_cast<uint8_t>(bytes[i + 1]);
-    if (marker == 0xDA) last_scan = i;
-    if (marker == 0xD9) last_end = i;
+  const auto at = [&](size_t i) { return static_cast<uint8_t>(bytes[i]); };
+  size_t i = 2;  // after FF D8
+  while (i + 1 < bytes.size()) {
+    if (at(i) != 0xFF) {  // extraneous bytes before a marker, which libjpeg skips too
+      ++i;
+      continue;
+    }
+    const uint8_t marker = at(i + 1);
+    if (marker == 0xFF) {  // fill byte before a marker
+      ++i;
+      continue;
+    }
+    if (marker == 0xD9) return true;
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // TEM, RSTn: no length
+      i += 2;
+      continue;
+    }
+    if (i + 3 >= bytes.size()) return false;
+    const size_t length = (size_t{at(i + 2)} << 8) | at(i + 3);  // includes its own 2 bytes
+    if (length < 2) return false;
+    i += 2 + length;
+    if (marker != 0xDA) continue;
+    // Entropy-coded data of the scan: up to the next FF that is neither FF 00 nor a restart.
+    while (i + 1 < bytes.size()) {
+      const uint8_t next = at(i + 1);
+      if (at(i) == 0xFF && next != 0x00 && !(next >= 0xD0 && next <= 0xD7) && next != 0xFF) break;
+      ++i;
+    }
   }
-  return last_scan != std::string::npos && last_end != std::string::npos && last_end > last_scan;
+  return false;
 }
 
 cv::Mat ReadUnchanged(const std::string& path, const char* what) {

@@ -173,7 +173,8 @@ TEST(Images, GrayRgbAndSixteenBit) {
 
 // A truncated file is an error naming it: libpng fails, and libjpeg would decode the part
 // that is there (the rest grey) but for the check of the end-of-image marker. Bytes a camera
-// appends after the image are allowed.
+// appends after the image are allowed, whatever markers they hold. Progressive JPEGs (several
+// scans) and restart markers within a scan are walked through.
 TEST(Images, TruncatedImagesAreErrors) {
   const std::string dir = MakeTestDir("truncated");
   cv::Mat noise(48, 64, CV_8UC3);
@@ -194,10 +195,29 @@ TEST(Images, TruncatedImagesAreErrors) {
         << error;
   }
   const std::string trailer = JoinPaths(dir, "trailer.jpg");
+  // A motion photo's video after the image: a start-of-scan marker (FF DA) and no end marker.
   WriteFileAtomically(trailer, [&](std::ostream& out) {
-    out << ReadTextFile(JoinPaths(dir, "whole.jpg")) << "appended by a camera";
+    out << ReadTextFile(JoinPaths(dir, "whole.jpg")) << "ftypmp42"
+        << std::string("\x00\x00\xff\xda\x12\x34", 6) << "appended by a camera";
   });
   EXPECT_EQ(ReadImageGray(trailer).Height(), 48);
+  // Several scans: read whole (libjpeg refuses a cut progressive file itself).
+  const std::string progressive = JoinPaths(dir, "progressive.jpg");
+  ASSERT_TRUE(cv::imwrite(progressive, noise, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}));
+  EXPECT_EQ(ReadImageGray(progressive).Width(), 64);
+  // Restart markers within the scan: read whole, and refused when cut within the scan or just
+  // before the end-of-image marker.
+  const std::string restarts = JoinPaths(dir, "restarts.jpg");
+  ASSERT_TRUE(cv::imwrite(restarts, noise, {cv::IMWRITE_JPEG_RST_INTERVAL, 1}));
+  EXPECT_EQ(ReadImageGray(restarts).Width(), 64);
+  const std::string restart_bytes = ReadTextFile(restarts);
+  for (const size_t kept : {restart_bytes.size() / 2, restart_bytes.size() - 2}) {
+    const std::string cut = JoinPaths(dir, "restarts_cut.jpg");
+    WriteFileAtomically(cut, [&](std::ostream& out) { out << restart_bytes.substr(0, kept); });
+    const std::string error = ErrorOf([&] { ReadImageGray(cut); });
+    EXPECT_NE(error.find("Truncated image"), std::string::npos)
+        << kept << " of " << restart_bytes.size() << " bytes: " << error;
+  }
   const std::string empty = JoinPaths(dir, "empty.png");
   WriteFileAtomically(empty, [](std::ostream&) {});
   EXPECT_NE(ErrorOf([&] { ReadMask(empty, 4, 4); }).find("Cannot decode mask"), std::string::npos);
