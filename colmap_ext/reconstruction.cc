@@ -212,11 +212,14 @@ T ParseInteger(const std::string& token, const std::string& where, const char* w
   return value;
 }
 
+// strtod reports ERANGE for an underflow too (1e-310, which COLMAP reads and writes as a
+// denormal); only an overflow, which comes back as +-HUGE_VAL, is not a number we can use.
 double ParseDouble(const std::string& token, const std::string& where, const char* what) {
   errno = 0;
   char* end = nullptr;
   const double value = std::strtod(token.c_str(), &end);
-  THROW_IF(end != token.c_str() + token.size() || token.empty() || errno == ERANGE,
+  const bool overflow = errno == ERANGE && std::abs(value) == HUGE_VAL;
+  THROW_IF(end != token.c_str() + token.size() || token.empty() || overflow,
            where << ": cannot parse " << what << " from '" << token << "'");
   return value;
 }

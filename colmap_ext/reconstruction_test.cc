@@ -276,6 +276,7 @@ TEST(Reconstruction, BadTextInputThrowsNamingFileAndLine) {
       {"1 1 0 0 0 0 0 0 1 a.png\n1.0 2.0\n", ReadImagesText, "multiple of 3"},
       {"1 1 0 0 0 0 0 0 1 a.png\n# no\n", ReadImagesText, "comment"},
       {"1 0 0 0 0 0 0 0 1 a.png\n\n", ReadImagesText, "quaternion"},
+      {"1 1 0 0 0 1e400 0 0 1 a.png\n\n", ReadImagesText, "translation from '1e400'"},
       {"1 1 2 3 255 0 0 0.5 1\n", ReadPoints3DText, "tokens"},
       {"1 1 2 3 256 0 0 0.5\n", ReadPoints3DText, "outside 0-255"},
   };
@@ -302,6 +303,17 @@ TEST(Reconstruction, TextToleratesCrlfTrailingSpacesAndComments) {
   EXPECT_EQ(r.images.at(1).points2D[1].point3D_id, 7u);
   EXPECT_EQ(r.points3D.at(7).rgb[2], 30);
   EXPECT_EQ(r.points3D.at(7).track[0].point2D_idx, 1u);
+}
+
+// COLMAP writes what it holds with 17 digits, a denormal too (9.9999999999999694e-311), and
+// reads it back; so do we. strtod flags the underflow as a range error all the same.
+TEST(Reconstruction, TextReadsDenormalNumbers) {
+  std::istringstream images("1 1 0 0 0 9.9999999999999694e-311 0 0 1 a.png\n1e-320 2.5 -1\n");
+  Reconstruction r;
+  ReadImagesText(images, "images.txt", &r);
+  EXPECT_GT(r.images.at(1).t().x(), 0.0);
+  EXPECT_LT(r.images.at(1).t().x(), 1e-300);
+  EXPECT_GT(r.images.at(1).points2D.at(0).xy.x(), 0.0);
 }
 
 TEST(Reconstruction, ImageOrderFollowsTheFile) {
