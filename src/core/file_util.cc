@@ -19,10 +19,15 @@ namespace fs = std::filesystem;
 
 namespace hairmvs {
 
+// As COLMAP's JoinPaths (boost::filesystem's `/`, which appends): `b` goes under `a` even when
+// it starts with a separator, as an image name in a model may: colmap image_undistorter writes
+// the image "/x/a.png" to <workspace>/images/x/a.png and its depth maps under stereo/ alike,
+// where std::filesystem's `/` would replace `a` with `b` and reach outside the workspace.
 std::string JoinPaths(const std::string& a, const std::string& b) {
   if (a.empty()) return b;
-  if (b.empty()) return a;
-  return (fs::path(a) / fs::path(b)).string();
+  const size_t relative = b.find_first_not_of('/');
+  if (relative == std::string::npos) return a;
+  return (fs::path(a) / fs::path(b.substr(relative))).string();
 }
 
 bool ExistsFile(const std::string& path) {

@@ -19,6 +19,16 @@ namespace {
 
 using testing_util::MakeTestDir;
 
+// COLMAP's joining: a second part that starts with a separator (an image name such as
+// "/x/a.png" in a model) still goes under the first.
+TEST(FileUtil, JoinPathsAppendsAsColmapDoes) {
+  EXPECT_EQ(JoinPaths("ws", "images", "a.png"), "ws/images/a.png");
+  EXPECT_EQ(JoinPaths("ws/images", "/x/a.png"), "ws/images/x/a.png");
+  EXPECT_EQ(JoinPaths("/ws/", "//x/a.png"), "/ws/x/a.png");
+  EXPECT_EQ(JoinPaths("ws", ""), "ws");
+  EXPECT_EQ(JoinPaths("", "/x/a.png"), "/x/a.png");
+}
+
 TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
   const std::string dir = MakeTestDir("atomic");
   const std::string path = JoinPaths(dir, "sub", "file.txt");
