@@ -1,6 +1,7 @@
 #include "colmap_ext/mat_io.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <cstring>
 #include <iomanip>
@@ -74,6 +75,19 @@ FloatMap ReadMatPayload(std::istream& in, const MatShape& shape, const std::stri
   RequirePayloadBytes(shape, found,
                       found == PayloadBytes(shape) && in.peek() != std::char_traits<char>::eof(),
                       source);
+  // COLMAP's maps hold finite numbers (0 where a pixel has no depth or normal). An infinite
+  // depth or a NaN normal would pass the tests that compare it (d > 0, |n|^2 < 0.5 is false)
+  // and reach the fusion's grid and the evaluation's searches.
+  const std::vector<float>& values = map.Data();
+  const auto bad = std::find_if(values.begin(), values.end(),
+                                [](float v) { return !std::isfinite(v); });
+  if (bad != values.end()) {
+    const size_t i = static_cast<size_t>(bad - values.begin());
+    const size_t plane = static_cast<size_t>(shape.width) * shape.height;
+    HAIRMVS_THROW(source << ": Mat file holds a non-finite value (" << *bad << ") at pixel ("
+                         << i % plane % shape.width << ", " << i % plane / shape.width
+                         << "), channel " << i / plane);
+  }
   return map;
 }
 

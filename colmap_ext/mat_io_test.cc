@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "colmap_ext/test_util.h"
@@ -47,6 +48,21 @@ TEST(MatIo, BadInput) {
   std::istringstream zero("0&4&1&");
   EXPECT_THROW(ReadMat(zero, "d.bin"), Error);
   EXPECT_THROW(ReadMat("/nonexistent/d.bin"), Error);
+}
+
+// An infinite depth or a NaN normal is refused, naming the file, the pixel and the channel.
+TEST(MatIo, NonFiniteValuesAreRefused) {
+  for (const float bad : {std::numeric_limits<float>::infinity(),
+                          -std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN()}) {
+    FloatMap map(3, 2, 2, 0.5f);
+    map.At(1, 2, 1) = bad;  // row 1, column 2, channel 1
+    std::stringstream ss;
+    WriteMat(ss, map);
+    const std::string error = testing_util::ErrorOf([&] { ReadMat(ss, "n.bin"); });
+    EXPECT_NE(error.find("n.bin: Mat file holds a non-finite value"), std::string::npos) << error;
+    EXPECT_NE(error.find("at pixel (2, 1), channel 1"), std::string::npos) << error;
+  }
 }
 
 // ReadMatShape reads the header alone and fails, as ReadMat does, on a file of the wrong size.
