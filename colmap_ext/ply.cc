@@ -278,6 +278,17 @@ VertexLayout FindVertexLayout(const PlyElement& vertex, const std::string& sourc
   return layout;
 }
 
+// The three properties `index` of a vertex row, refused unless finite: a NaN or infinite point
+// would pass every test that compares it and wreck the nearest-neighbour searches and the
+// Poisson grid that take it.
+Eigen::Vector3f FiniteVector(const int index[3], const std::vector<double>& s, uint64_t row,
+                             const char* what, const std::string& source) {
+  const Eigen::Vector3f v = Eigen::Vector3d(s[index[0]], s[index[1]], s[index[2]]).cast<float>();
+  THROW_IF(!v.allFinite(), source << ": vertex " << row << " has a non-finite " << what << " ("
+                                  << v.x() << ", " << v.y() << ", " << v.z() << ")");
+  return v;
+}
+
 uint8_t ToByte(double v) {
   return static_cast<uint8_t>(std::clamp(std::lround(v), 0L, 255L));
 }
@@ -346,15 +357,13 @@ std::vector<FusedPoint> ReadFusedPlyPoints(std::istream& in, const std::string& 
   std::vector<FusedPoint> points;
   points.reserve(static_cast<size_t>(std::min<uint64_t>(vertex->count, 1u << 24)));
   ReadPlyBody(in, header, source,
-              [&](const PlyElement& element, uint64_t, const std::vector<double>& s,
+              [&](const PlyElement& element, uint64_t row, const std::vector<double>& s,
                   const std::vector<std::vector<double>>&) {
                 if (&element != vertex) return;
                 FusedPoint p;
-                for (int k = 0; k < 3; ++k) p.xyz[k] = static_cast<float>(s[layout.xyz[k]]);
+                p.xyz = FiniteVector(layout.xyz, s, row, "position", source);
                 if (layout.has_normals) {
-                  for (int k = 0; k < 3; ++k) {
-                    p.normal[k] = static_cast<float>(s[layout.normal[k]]);
-                  }
+                  p.normal = FiniteVector(layout.normal, s, row, "normal", source);
                 }
                 if (layout.has_colors) {
                   for (int k = 0; k < 3; ++k) p.rgb[k] = ToByte(s[layout.rgb[k]]);
@@ -451,11 +460,9 @@ TriangleMesh ReadMeshPly(std::istream& in, const std::string& source) {
               [&](const PlyElement& element, uint64_t row, const std::vector<double>& s,
                   const std::vector<std::vector<double>>& lists) {
                 if (&element == vertex) {
-                  mesh.vertices.emplace_back(s[layout.xyz[0]], s[layout.xyz[1]],
-                                             s[layout.xyz[2]]);
+                  mesh.vertices.push_back(FiniteVector(layout.xyz, s, row, "position", source));
                   if (layout.has_normals) {
-                    mesh.normals.emplace_back(s[layout.normal[0]], s[layout.normal[1]],
-                                              s[layout.normal[2]]);
+                    mesh.normals.push_back(FiniteVector(layout.normal, s, row, "normal", source));
                   }
                   if (layout.has_colors) {
                     mesh.colors.push_back({ToByte(s[layout.rgb[0]]), ToByte(s[layout.rgb[1]]),
@@ -466,7 +473,8 @@ TriangleMesh ReadMeshPly(std::istream& in, const std::string& source) {
                   THROW_IF(idx.size() < 3, source << ": face " << row << " has " << idx.size()
                                                   << " vertices");
                   for (double v : idx) {
-                    THROW_IF(v < 0 || v >= static_cast<double>(num_vertices),
+                    THROW_IF(!(v >= 0 && v < static_cast<double>(num_vertices)) ||
+                                 v != std::floor(v),
                              source << ": face " << row << " refers to vertex " << v << " of "
                                     << num_vertices);
                   }

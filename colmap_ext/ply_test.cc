@@ -206,5 +206,32 @@ TEST(MeshPly, ElementCountsAreCheckedAndEmptyElementsSkipped) {
   EXPECT_EQ(ReadMeshPly(empty_element, "j.ply").faces.size(), 1u);
 }
 
+// A NaN or infinite coordinate, or a face index that is not a whole number, is refused with the
+// file and the row named: such a vertex passes every comparison and wrecks the nearest-neighbour
+// searches of the evaluation and the fusion's grid.
+TEST(MeshPly, NonFiniteVerticesAndFractionalIndicesAreRefused) {
+  const std::string head =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  const auto error_of = [&](const std::string& body) {
+    std::istringstream in(head + body);
+    return testing_util::ErrorOf([&] { ReadMeshPly(in, "m.ply"); });
+  };
+  EXPECT_NE(error_of("0 0 0 0 0 1\n1 nan 0 0 0 1\n1 1 0 0 0 1\n3 0 1 2\n")
+                .find("m.ply: vertex 1 has a non-finite position"),
+            std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 inf 1\n3 0 1 2\n")
+                .find("m.ply: vertex 2 has a non-finite normal"),
+            std::string::npos);
+  EXPECT_NE(error_of("0 0 0 0 0 1\n1 0 0 0 0 1\n1 1 0 0 0 1\n3 0 1.5 2\n")
+                .find("m.ply: face 0 refers to vertex 1.5"),
+            std::string::npos);
+  std::istringstream points(head + "0 0 0 0 0 1\n1e39 0 0 0 0 1\n1 1 0 0 0 1\n3 0 1 2\n");
+  EXPECT_NE(testing_util::ErrorOf([&] { ReadFusedPlyPoints(points, "f.ply"); })
+                .find("f.ply: vertex 1 has a non-finite position"),
+            std::string::npos);
+}
+
 }  // namespace
 }  // namespace hairmvs
