@@ -258,38 +258,56 @@ StrandDistance::StrandDistance(const GroundTruthStrands& strands, double max_spa
     : index_(std::make_unique<Index>()) {
   THROW_IF(!(max_spacing_m > 0), "StrandDistance: max_spacing_m must be > 0");
   THROW_IF(strands.points.empty(), "StrandDistance: no strand points");
+  // Segment k of the strand of n points at `begin`: its spline's four control points (end
+  // points repeated: the spline starts at the root and ends at the tip) and the steps that
+  // sample it no further apart than max_spacing_m (its arc length bounded by the Bezier control
+  // polygon). Steps in double: a tiny spacing must be refused below, not overflow an int.
+  struct Segment {
+    Eigen::Vector3d p[4];
+    double steps = 1;
+  };
+  const auto segment = [&](int64_t begin, int64_t n, int64_t k) {
+    Segment seg;
+    for (int i = 0; i < 4; ++i) {
+      seg.p[i] = strands.points[begin + std::clamp<int64_t>(k - 1 + i, 0, n - 1)].cast<double>();
+    }
+    const Eigen::Vector3d b1 = seg.p[1] + (seg.p[2] - seg.p[0]) / 6.0;
+    const Eigen::Vector3d b2 = seg.p[2] - (seg.p[3] - seg.p[1]) / 6.0;
+    const double length_bound = (b1 - seg.p[1]).norm() + (b2 - b1).norm() + (seg.p[2] - b2).norm();
+    seg.steps = std::max(1.0, std::ceil(length_bound / max_spacing_m));
+    return seg;
+  };
+  double num_samples = 0;
+  for (size_t s = 0; s < strands.NumStrands(); ++s) {
+    const int64_t n = strands.offsets[s + 1] - strands.offsets[s];
+    if (n > 0) num_samples += 1;
+    for (int64_t k = 0; k + 1 < n; ++k) num_samples += segment(strands.offsets[s], n, k).steps;
+  }
+  THROW_IF(num_samples > kMaxDistanceSamples,
+           "Sampling the true strands every " << max_spacing_m << " m would take " << num_samples
+                                              << " samples; use a larger strand spacing");
   std::vector<Eigen::Vector3f>& samples = index_->samples;
   std::vector<uint8_t>& connected = index_->connected;
+  samples.reserve(static_cast<size_t>(num_samples));
+  connected.reserve(static_cast<size_t>(num_samples));
   for (size_t s = 0; s < strands.NumStrands(); ++s) {
     const int64_t begin = strands.offsets[s];
-    const int64_t end = strands.offsets[s + 1];
-    const int64_t n = end - begin;
+    const int64_t n = strands.offsets[s + 1] - begin;
     if (n <= 0) continue;
-    auto point = [&](int64_t k) {
-      // End points repeated: the spline starts at the root and ends at the tip.
-      k = std::clamp<int64_t>(k, 0, n - 1);
-      return strands.points[begin + k].cast<double>();
-    };
     samples.push_back(strands.points[begin]);
     connected.push_back(1);
     for (int64_t k = 0; k + 1 < n; ++k) {
-      const Eigen::Vector3d p0 = point(k - 1), p1 = point(k), p2 = point(k + 1),
-                            p3 = point(k + 2);
-      // Bound the arc length by the Bezier control polygon of the segment.
-      const Eigen::Vector3d b1 = p1 + (p2 - p0) / 6.0;
-      const Eigen::Vector3d b2 = p2 - (p3 - p1) / 6.0;
-      const double length_bound = (b1 - p1).norm() + (b2 - b1).norm() + (p2 - b2).norm();
-      const int steps = std::max(1, static_cast<int>(std::ceil(length_bound / max_spacing_m)));
+      const Segment seg = segment(begin, n, k);
+      const int steps = static_cast<int>(seg.steps);
       for (int j = 1; j <= steps; ++j) {
-        samples.push_back(CatmullRom(p0, p1, p2, p3, static_cast<double>(j) / steps).cast<float>());
+        samples.push_back(CatmullRom(seg.p[0], seg.p[1], seg.p[2], seg.p[3],
+                                     static_cast<double>(j) / steps)
+                              .cast<float>());
         connected.push_back(1);
       }
     }
     connected.back() = 0;
   }
-  THROW_IF(samples.size() >= std::numeric_limits<uint32_t>::max(),
-           "StrandDistance: too many samples (" << samples.size()
-                                                << "); use a larger max_spacing_m");
   for (size_t i = 0; i + 1 < samples.size(); ++i) {
     if (connected[i]) {
       index_->max_segment_m = std::max(

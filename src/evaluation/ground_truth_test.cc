@@ -89,6 +89,15 @@ TEST(GroundTruth, StrandDistanceMatchesBruteForce) {
   EXPECT_NEAR(distance.Distance(strands.points[3].cast<double>()), 0.0, 1e-7);
 }
 
+// A spacing far below the strands' scale is refused from the count of the samples it would
+// take, before they are made.
+TEST(GroundTruth, StrandDistanceTooFineForMemoryIsAnError) {
+  const std::string error =
+      testing_util::ErrorOf([&] { StrandDistance(TestStrands(), 1e-12); });
+  EXPECT_NE(error.find("Sampling the true strands every 1e-12 m would take"), std::string::npos)
+      << error;
+}
+
 TEST(GroundTruth, MissingFolderIsNamedAsTheGroundTruth) {
   const std::string missing = JoinPaths(::testing::TempDir(), "hairmvs_gt_no_such_folder");
   std::filesystem::remove_all(missing);

@@ -69,8 +69,7 @@ std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double 
     area_m2 += face_areas_m2.back();
   }
   // Before a per-face count overflows int or the samples fill the memory.
-  constexpr double kMaxSamples = 5e8;
-  THROW_IF(area_m2 / cell > kMaxSamples,
+  THROW_IF(area_m2 / cell > kMaxDistanceSamples,
            "Sampling " << area_m2 << " m^2 of mesh every " << spacing_m << " m would take "
                        << area_m2 / cell << " samples; use a larger sample spacing");
   for (size_t face = 0; face < mesh.faces.size(); ++face) {
@@ -148,6 +147,9 @@ TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double samp
   index_->spacing_m = sample_spacing_m;
   for (const Eigen::Vector3f& v : mesh.vertices) index_->vertices.push_back(v.cast<double>());
   index_->faces = mesh.faces;
+  // Barycentric grid with m steps per edge: every point is within longest/m of a grid point.
+  std::vector<double> steps(mesh.faces.size());
+  double num_samples = 0;
   for (size_t fi = 0; fi < mesh.faces.size(); ++fi) {
     const Eigen::Vector3i& f = mesh.faces[fi];
     for (int k = 0; k < 3; ++k) {
@@ -159,8 +161,19 @@ TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double samp
     const Eigen::Vector3d b = index_->vertices[f(1)];
     const Eigen::Vector3d c = index_->vertices[f(2)];
     const double longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
-    // Barycentric grid with m steps per edge: every point is within longest/m of a grid point.
-    const int m = std::max(1, static_cast<int>(std::ceil(longest / sample_spacing_m)));
+    steps[fi] = std::max(1.0, std::ceil(longest / sample_spacing_m));
+    num_samples += (steps[fi] + 1) * (steps[fi] + 2) / 2;
+  }
+  THROW_IF(num_samples > kMaxDistanceSamples,
+           "Sampling the mesh's " << mesh.faces.size() << " faces every " << sample_spacing_m
+                                  << " m would take " << num_samples
+                                  << " samples; use a larger sample spacing");
+  for (size_t fi = 0; fi < mesh.faces.size(); ++fi) {
+    const Eigen::Vector3i& f = mesh.faces[fi];
+    const Eigen::Vector3d a = index_->vertices[f(0)];
+    const Eigen::Vector3d b = index_->vertices[f(1)];
+    const Eigen::Vector3d c = index_->vertices[f(2)];
+    const int m = static_cast<int>(steps[fi]);
     for (int i = 0; i <= m; ++i) {
       for (int j = 0; i + j <= m; ++j) {
         const double u = static_cast<double>(i) / m, v = static_cast<double>(j) / m;
@@ -168,8 +181,6 @@ TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double samp
         index_->sample_face.push_back(static_cast<uint32_t>(fi));
       }
     }
-    THROW_IF(index_->samples.size() >= std::numeric_limits<uint32_t>::max(),
-             "TriangleMeshDistance: too many samples; use a larger sample spacing");
   }
   index_->tree = BuildSampleTree(*index_);
 }

@@ -102,5 +102,16 @@ TEST(MeshDistance, SurfaceSamplesFollowTheArea) {
   EXPECT_NE(error.find("use a larger sample spacing"), std::string::npos) << error;
 }
 
+// The same for the index of the mesh's surface: the count is known before the samples are made
+// (1e12 here), so the error comes at once, not after the memory is full.
+TEST(MeshDistance, IndexTooFineForMemoryIsAnError) {
+  TriangleMesh square;
+  square.vertices = {{0, 0, 0}, {0.01f, 0, 0}, {0.01f, 0.01f, 0}, {0, 0.01f, 0}};
+  square.faces = {{0, 1, 2}, {0, 2, 3}};
+  const std::string error = testing_util::ErrorOf([&] { TriangleMeshDistance(square, 1e-8); });
+  EXPECT_NE(error.find("every 1e-08 m would take"), std::string::npos) << error;
+  EXPECT_NE(error.find("use a larger sample spacing"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace hairmvs

@@ -24,6 +24,11 @@ struct SampleCloud {
   }
 };
 
+// The most samples an evaluator indexes (about 16 bytes each with the tree's index): a spacing
+// far below the data's scale, or a mesh in millimetres read as metres, is refused before the
+// samples are made rather than filling the memory.
+constexpr double kMaxDistanceSamples = 5e8;
+
 using SampleTree =
     nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, SampleCloud>,
                                         SampleCloud, 3, uint32_t>;
