@@ -22,8 +22,10 @@ struct ImportGroundTruthOptions {
   // Keep only hair pixels (label 2); otherwise hair and head skin (labels 1, 2).
   bool hair_only = false;
   // Median-filter the true depth maps (k x k over the kept pixels, 0 = off) before writing:
-  // the README's "ideal smooth surface" (7).
+  // the README's "ideal smooth surface" (7). At most kMaxMedianFilterPx: each pixel sorts
+  // k^2 depths, and a window of the image's size is no longer a surface's local shape.
   int median_filter_px = 0;
+  static constexpr int kMaxMedianFilterPx = 99;
   // 1: a plain median (background zeros count; every pixel filtered, then the labels
   // applied); 0: the median of the kept depths around each kept pixel.
   bool median_include_background = true;
@@ -38,7 +40,7 @@ struct ImportGroundTruthOptions {
     v("seed", &seed, "random seed of the noise");
     v("hair_only", &hair_only, "keep hair pixels only (else hair and head skin)");
     v("median_filter_px", &median_filter_px,
-      "median-filter the true depths over a k x k window (0 = off; odd)");
+      "median-filter the true depths over a k x k window (0 = off; odd, at most 99)");
     v("median_include_background", &median_include_background,
       "plain median with background zeros (1) or of the kept depths only (0)");
     v("copy_images", &copy_images, "copy images/ and masks/ instead of symlinking");

@@ -79,6 +79,7 @@ int RunPipeline(int argc, char** argv) {
   THROW_IF(!orientation_options.Check(&error), "--OrientationField: " << error);
   THROW_IF(!stereo_options.Check(&error), "--OrientationStereo: " << error);
   THROW_IF(!fusion_options.Check(&error), "--TemplateFusion: " << error);
+  THROW_IF(!source_options.Check(&error), "--SourceViews: " << error);
   for (const std::string& stage : stages) {
     THROW_IF(stage != "orientation" && stage != "stereo" && stage != "fusion",
              "--stages: unknown stage '" << stage << "' (orientation, stereo, fusion)");
@@ -151,6 +152,7 @@ int RunPipeline(int argc, char** argv) {
         &source_options, &orientation_options);
     std::printf("%s\n", result.BriefReport().c_str());
   }
+  bool fused = false;  // whether meshed-hair.ply is this run's
   if (HasStage(stages, "fusion")) {
     if (!image_names.empty()) {
       std::fprintf(stderr,
@@ -162,11 +164,18 @@ int RunPipeline(int argc, char** argv) {
       const TemplateFusionResult result =
           RunTemplateFusion(workspace_path, fusion_options, &timings);
       std::printf("%s\n", result.BriefReport().c_str());
+      fused = true;
     }
   }
 
   if (!ground_truth_path.empty()) {
     std::fprintf(stderr, "[pipeline] evaluation against %s\n", ground_truth_path.c_str());
+    // What an earlier run left is evaluated too, but said to be so.
+    if (!HasStage(stages, "stereo")) {
+      std::fprintf(stderr,
+                   "[pipeline] the stereo stage did not run in this call: evaluating the depth "
+                   "maps an earlier run wrote\n");
+    }
     DepthEvaluationOptions depth_options;
     depth_options.image_names = image_names;
     depth_options.depth_type = stereo_options.FinalMapType();  // what the stereo stage wrote
@@ -187,6 +196,12 @@ int RunPipeline(int argc, char** argv) {
     }
     const std::string mesh_path = JoinPaths(workspace_path, "meshed-hair.ply");
     if (ExistsFile(mesh_path)) {
+      if (!fused) {
+        std::fprintf(stderr,
+                     "[pipeline] the fusion stage did not run in this call: evaluating the "
+                     "%s an earlier run wrote\n",
+                     mesh_path.c_str());
+      }
       ScopedStageTimer timer(&timings, "evaluate_mesh");
       const MeshEvaluationResult mesh =
           EvaluateMesh(mesh_path, ground_truth_path, workspace_path, mesh_options, *strands);

@@ -50,7 +50,7 @@ FloatMap MedianFilterValidDepths(const FloatMap& depth, int k, bool include_inva
 #pragma omp parallel for schedule(dynamic, 8)
   for (int r = 0; r < height; ++r) {
     std::vector<float> window;
-    window.reserve(k * k);
+    window.reserve(static_cast<size_t>(std::min(k, height)) * std::min(k, width));
     for (int c = 0; c < width; ++c) {
       if (!include_invalid && !(depth.At(r, c) > 0)) continue;
       window.clear();

@@ -103,8 +103,10 @@ bool ImportGroundTruthOptions::Check(std::string* error) const {
     *error = "--noise_m must be >= 0";
     return false;
   }
-  if (median_filter_px < 0 || (median_filter_px > 0 && median_filter_px % 2 == 0)) {
-    *error = "--median_filter_px must be 0 or odd";
+  if (median_filter_px < 0 || median_filter_px > kMaxMedianFilterPx ||
+      (median_filter_px > 0 && median_filter_px % 2 == 0)) {
+    *error = "--median_filter_px must be 0 or odd, at most " +
+             std::to_string(kMaxMedianFilterPx);
     return false;
   }
   return CheckImageNames(image_names, error);

@@ -101,6 +101,18 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
                       " --surface_sample_spacing_m 0");
   EXPECT_NE(output.text.find("--surface_sample_spacing_m must be > 0"), std::string::npos)
       << output.text;
+  // Every section of the pipeline is checked before its first stage runs.
+  output = RunHairmvs("pipeline --workspace_path " + dir + " --SourceViews.max_num_source_views 0");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--SourceViews: max_num_source_views must be >= 1"),
+            std::string::npos)
+      << output.text;
+  output = RunHairmvs("import_ground_truth --ground_truth_path " + dir + " --workspace_path " +
+                      dir + " --output_path " + JoinPaths(dir, "out") + " --median_filter_px 101");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--median_filter_px must be 0 or odd, at most 99"), std::string::npos)
+      << output.text;
+  EXPECT_FALSE(ExistsDir(JoinPaths(dir, "out")));
   std::filesystem::remove_all(dir);
 }
 
