@@ -8,6 +8,7 @@
 //     mesh), as the DTU benchmark measures them.
 // Distances are reported in millimetres (fields *_mm), inputs are in metres (*_m).
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -281,11 +282,13 @@ struct MeshEvaluationOptions {
   bool Check(std::string* error) const;
 };
 
+// Of no values (a view without a depth): NaN, which the tables print as nan and the JSON
+// summaries write as null, rather than an error of 0 mm that reads as perfect.
 struct DistanceStats {
   long count = 0;
-  double mean_mm = 0;
-  double median_mm = 0;
-  double p90_mm = 0;
+  double mean_mm = std::numeric_limits<double>::quiet_NaN();
+  double median_mm = std::numeric_limits<double>::quiet_NaN();
+  double p90_mm = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct MeshEvaluationResult {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "src/core/file_util.h"
@@ -20,7 +21,7 @@ double Mean(const std::vector<double>& values) {
 }
 
 double Percentile(std::vector<double> values, double q) {
-  if (values.empty()) return 0.0;
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
   const size_t k = std::min(values.size() - 1,
                             static_cast<size_t>(std::floor(q * (values.size() - 1) + 0.5)));
   std::nth_element(values.begin(), values.begin() + k, values.end());

@@ -21,7 +21,7 @@ std::vector<double> Absolute(std::vector<double> values);
 
 // Mean, median and 90th percentile of distances given in metres, reported in mm.
 DistanceStats SummarizeDistances(std::vector<double> distances_m);
-// Percentile q in [0, 1] (nearest rank on the sorted values); 0 for an empty vector.
+// Percentile q in [0, 1] (nearest rank on the sorted values); NaN for an empty vector.
 double Percentile(std::vector<double> values, double q);
 double Mean(const std::vector<double>& values);
 

@@ -169,6 +169,21 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
   EXPECT_EQ(json["overall"]["num_hair_pixels"].get<long>(), result.overall.num_hair_pixels);
   EXPECT_NE(result.Table().find("overall"), std::string::npos);
 
+  // A view whose map holds no depth: 0% complete, and its errors are no figure (NaN: nan in
+  // the table, null in the JSON), not 0 mm.
+  WriteMat(v1, FloatMap(depth.Width(), depth.Height(), 1, 0.0f));
+  const DepthEvaluationResult empty = EvaluateDepthMaps(out, scene.gt, FastDepthOptions());
+  ASSERT_EQ(empty.views.size(), 2u);
+  const DepthMetrics& without = empty.views[1];
+  EXPECT_EQ(without.name, "v1.png");
+  EXPECT_EQ(without.completeness, 0.0);
+  EXPECT_TRUE(std::isnan(without.median_abs_error_mm));
+  EXPECT_TRUE(std::isnan(without.accuracy_3d_median_mm));
+  EXPECT_TRUE(nlohmann::json::parse(ReadTextFile(empty.json_path))["views"][1]
+                  ["median_abs_error_mm"]
+                      .is_null());
+  EXPECT_FALSE(std::isnan(empty.overall.median_abs_error_mm));
+
   // A view without its map is named as left out of the overall figures; a view asked for that
   // the workspace lacks is an error, not a missing file.
   std::filesystem::remove(v1);
@@ -348,10 +363,11 @@ TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
   const auto json = nlohmann::json::parse(ReadTextFile(result.json_path));
   EXPECT_NEAR(json["overall"]["rough_median_abs_error_mm"].get<double>(), 0.0, 1e-9);
 
+  // Off: no split, so no figure (NaN: nan in the table, null in the JSON), not 0 mm.
   options.smooth_error_window_px = 0;
   m = EvaluateDepthMaps(v0.workspace, v0.scene.gt, options).overall;
-  EXPECT_EQ(m.smooth_median_abs_error_mm, 0.0);
-  EXPECT_EQ(m.rough_median_abs_error_mm, 0.0);
+  EXPECT_TRUE(std::isnan(m.smooth_median_abs_error_mm));
+  EXPECT_TRUE(std::isnan(m.rough_median_abs_error_mm));
   options.smooth_error_window_px = 4;
   std::string error;
   EXPECT_FALSE(options.Check(&error));
