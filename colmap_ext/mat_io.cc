@@ -131,8 +131,14 @@ CostVolume ReadCostVolume(const std::string& path, const std::string& depths_pat
     if (line.empty() || line[0] == '#') continue;
     char* end = nullptr;
     const double depth = std::strtod(line.c_str(), &end);
-    THROW_IF(end == line.c_str() || *end != '\0' || !(depth > 0),
+    THROW_IF(end == line.c_str() || *end != '\0' || !(depth > 0) || !std::isfinite(depth),
              depths_path << ":" << i + 1 << ": not a positive depth: '" << line << "'");
+    // The labels' depths run one way (the evaluation interpolates between neighbours).
+    const std::vector<double>& d = volume.label_depths;
+    THROW_IF(!d.empty() && (depth == d.back() ||
+                            (d.size() >= 2 && (depth > d.back()) != (d.back() > d[d.size() - 2]))),
+             depths_path << ":" << i + 1 << ": the label depths must run strictly one way; "
+                         << line << " follows " << d.back());
     volume.label_depths.push_back(depth);
   }
   THROW_IF(static_cast<int>(volume.label_depths.size()) != volume.cost.Channels(),

@@ -150,6 +150,11 @@ TEST(MatIo, CostVolumeRoundTripAndBadDepths) {
   expect_error("0.5\n0.6\n", "too few depths");
   expect_error("0.5\nfar\n", "a word");
   expect_error("-0.5\n", "a negative depth");
+  std::string labels;
+  for (int k = 0; k < 199; ++k) labels += std::to_string(0.4 + 0.001 * k) + "\n";
+  expect_error(labels + "inf\n", "an infinite depth");
+  expect_error(labels + std::to_string(0.4 + 0.001 * 198) + "\n", "a repeated depth");
+  expect_error(labels + "0.5\n", "a depth against the order");
   std::filesystem::remove(depths);
   EXPECT_THROW(ReadCostVolume(path, depths), Error);
   std::filesystem::remove_all(dir);
