@@ -125,7 +125,15 @@ FusionOutput FuseViews(const std::vector<FusionView>& views, const TemplateFusio
                                       << " points are seen by at least "
                                       << options.min_num_visible_views << " depth maps");
     out.fused = VoxelMergePoints(points, options.fused_voxel_size_px * out.footprint_m);
+    // Voxels whose normals cancel are dropped: maps that face every way at once leave nothing.
+    THROW_IF(out.fused.Size() < 2, "template_fusion: only "
+                                       << out.fused.Size() << " of " << points.Size()
+                                       << " points are left after merging voxels whose normals "
+                                          "agree; the depth maps' normals cancel out");
     out.cell_m = PoissonCellSize(out.fused, options);
+    THROW_IF(!(out.cell_m > 0), "template_fusion: the " << out.fused.Size()
+                                                        << " fused points lie at one place; "
+                                                           "there is no surface to mesh");
     samples = VoxelMergePoints(out.fused, options.poisson_sample_cells * out.cell_m);
     out.num_poisson_points = static_cast<int>(samples.Size());
     std::fprintf(stderr,

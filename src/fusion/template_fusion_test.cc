@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "src/core/test_util.h"
 #include "src/fusion/fusion_points.h"
 #include "src/fusion/fusion_test_scenes.h"
 #include "src/fusion/template_fusion_core.h"
@@ -72,6 +73,25 @@ TEST(TemplateFusion, PointsAreSeenByTheViewsThatAgree) {
   EXPECT_LT(max_error, 1e-4);
   // 12 views around a sphere: most points are seen by several.
   EXPECT_GT(num_multi_view, points.Size() / 2);
+}
+
+// Every view twice, once with its normals turned around: each voxel's normals cancel and the
+// merge keeps nothing, which is an error that says so (it was a failed CHECK in the Poisson
+// grid's cell size).
+TEST(TemplateFusion, NormalsThatCancelOutAreAnError) {
+  testing::SceneOptions scene;
+  std::vector<FusionView> views = testing::RenderViews(testing::SphereSdf(1.0), scene);
+  const size_t num_views = views.size();
+  for (size_t i = 0; i < num_views; ++i) {
+    FusionView turned = views[i];
+    if (turned.normal.Empty()) continue;
+    for (float& v : turned.normal.Data()) v = -v;
+    views.push_back(turned);
+  }
+  ASSERT_EQ(views.size(), 2 * num_views) << "the scene's views carry no normal maps";
+  const std::string error =
+      testing_util::ErrorOf([&] { FuseViews(views, TestOptions(), nullptr); });
+  EXPECT_NE(error.find("the depth maps' normals cancel out"), std::string::npos) << error;
 }
 
 TEST(TemplateFusion, NoisyMisalignedSphereIsOneGenusZeroSurface) {
