@@ -1,9 +1,11 @@
 #include "src/core/option_parser.h"
 
 #include <boost/program_options.hpp>
+#include <cmath>
 #include <iostream>
 #include <map>
 #include <sstream>
+#include <type_traits>
 
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
@@ -25,6 +27,10 @@ struct OptionParser::Impl {
   // defaults too, so a second option on one variable would overwrite a value given to the
   // first with its own default.
   std::map<const void*, std::string> typed_targets;
+  // Per floating-point option: whether its value is finite. The stream parser takes "inf" and
+  // "nan", which no option means and which pass many a range check (nan fails every
+  // comparison, inf passes every lower bound).
+  std::map<std::string, std::function<bool()>> finite_checks;
 };
 
 OptionParser::OptionParser(std::string command, std::string description)
@@ -43,6 +49,16 @@ std::string ToText(const T& value) {
   std::ostringstream ss;
   ss << value;
   return ss.str();
+}
+
+// Whether a floating-point option's value is finite; null for other types.
+template <typename T>
+std::function<bool()> FiniteCheck(const T* value) {
+  if constexpr (std::is_floating_point_v<T>) {
+    return [value] { return std::isfinite(*value); };
+  } else {
+    return nullptr;
+  }
 }
 
 std::string JoinNames(const std::vector<std::string>& values) {
@@ -65,6 +81,7 @@ std::string JoinNames(const std::vector<std::string>& values) {
     impl_->desc.add_options()(name.c_str(), semantic, help.c_str());                       \
     impl_->names.push_back(name);                                                          \
     impl_->printers[name] = [value] { return ToText(*value); };                            \
+    if (auto check = FiniteCheck(value)) impl_->finite_checks[name] = std::move(check);   \
   }
 
 HAIRMVS_ADD_TYPED_OPTION(int)
@@ -124,7 +141,13 @@ void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
 bool OptionParser::Parse(int argc, char** argv, int first) {
   std::vector<std::string> args(argv + first, argv + argc);
   try {
-    po::store(po::command_line_parser(args).options(impl_->desc).run(), impl_->vm);
+    // No positional arguments: a word that is not an option (a value given twice, a
+    // forgotten "--") is an error rather than dropped.
+    po::store(po::command_line_parser(args)
+                  .options(impl_->desc)
+                  .positional(po::positional_options_description())
+                  .run(),
+              impl_->vm);
     if (impl_->vm.count("help")) {
       std::cout << Help();
       return false;
@@ -141,6 +164,11 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
     THROW_IF(!parse(text), "hairmvs " << impl_->command << ": invalid value '" << text
                                       << "' for --" << name << " ("
                                       << impl_->desc.find(name, false).description() << ")");
+  }
+  for (const auto& [name, is_finite] : impl_->finite_checks) {
+    THROW_IF(!is_finite(), "hairmvs " << impl_->command << ": invalid value '"
+                                      << impl_->printers[name]() << "' for --" << name
+                                      << ": not a finite number");
   }
   for (const auto& [name, why] : impl_->ignored) {
     if (impl_->vm.count(name)) {

@@ -93,6 +93,36 @@ TEST(OptionParser, RejectsUnknownOptionsAndBadValues) {
   }
 }
 
+// A word that is not an option (a second value, a forgotten "--") and a number that is not
+// finite are errors naming what was typed, not dropped or taken.
+TEST(OptionParser, RejectsStrayWordsAndNonFiniteNumbers) {
+  for (const std::vector<std::string>& typed :
+       {std::vector<std::string>{"--Toy.num_levels", "2", "5"},
+        std::vector<std::string>{"--Toy.num_levels=2", "Toy.lambda=3"},
+        std::vector<std::string>{"--Toy.num_levels=2", "--", "--Toy.lambda", "3"}}) {
+    ToyOptions options;
+    OptionParser parser("toy", "a toy command");
+    parser.AddSection("Toy", &options);
+    std::vector<std::string> args = {"hairmvs", "toy"};
+    args.insert(args.end(), typed.begin(), typed.end());
+    auto argv = Argv(args);
+    const std::string error = testing_util::ErrorOf(
+        [&] { parser.Parse(static_cast<int>(argv.size()), argv.data()); });
+    EXPECT_NE(error.find("hairmvs toy: "), std::string::npos) << error;
+    EXPECT_NE(error.find("positional"), std::string::npos) << error;
+  }
+  for (const std::string value : {"inf", "-inf", "nan"}) {
+    ToyOptions options;
+    OptionParser parser("toy", "a toy command");
+    parser.AddSection("Toy", &options);
+    std::vector<std::string> args = {"hairmvs", "toy", "--Toy.lambda", value};
+    auto argv = Argv(args);
+    const std::string error = testing_util::ErrorOf(
+        [&] { parser.Parse(static_cast<int>(argv.size()), argv.data()); });
+    EXPECT_NE(error.find("for --Toy.lambda: not a finite number"), std::string::npos) << error;
+  }
+}
+
 TEST(OptionParser, MissingRequiredOptionIsAnError) {
   std::string workspace;
   OptionParser parser("toy", "a toy command");
