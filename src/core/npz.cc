@@ -14,6 +14,8 @@ namespace {
 
 constexpr char kNpyMagic[] = "\x93NUMPY";
 constexpr size_t kNpyMagicSize = 6;
+// Longest string element read (<U65536): image names and the like, far below it.
+constexpr unsigned long kMaxNpyStringChars = 65536;
 
 // Item size of a numeric descr such as "<f4"; 0 for an unknown one.
 size_t NumericItemSize(const std::string& dtype) {
@@ -219,6 +221,15 @@ NpyArray ParseNpy(const char* bytes, size_t size, const std::string& source) {
   const bool is_string = array.dtype.size() > 1 && array.dtype[1] == 'U';
   THROW_IF(!is_string && NumericItemSize(array.dtype) == 0,
            source << ": unsupported dtype " << array.dtype);
+  if (is_string) {
+    // "<U" and a character count of 1 to kMaxNpyStringChars (numpy writes at least <U1).
+    const std::string count = array.dtype.substr(2);
+    THROW_IF(array.dtype[0] != '<' || count.empty() || count.size() > 7 ||
+                 count.find_first_not_of("0123456789") != std::string::npos ||
+                 std::stoul(count) == 0 || std::stoul(count) > kMaxNpyStringChars,
+             source << ": unsupported dtype " << array.dtype << " (strings of 1 to "
+                    << kMaxNpyStringChars << " characters)");
+  }
   const std::string fortran = HeaderValue(header, "fortran_order", source);
   THROW_IF(fortran != "False",
            source << ": Fortran-order arrays are not supported (fortran_order = " << fortran
@@ -304,16 +315,20 @@ std::map<std::string, NpyArray> ReadNpz(const std::string& path) {
     zip_file_t* file = zip_fopen_index(archive, i, 0);
     THROW_IF(file == nullptr, source << ": cannot open entry: " << zip_strerror(archive));
     std::unique_ptr<zip_file_t, int (*)(zip_file_t*)> file_guard(file, zip_fclose);
-    std::vector<char> bytes(stat.size);
-    zip_int64_t read = 0;
-    while (read < static_cast<zip_int64_t>(bytes.size())) {
-      const zip_int64_t n = zip_fread(file, bytes.data() + read, bytes.size() - read);
+    // Read in chunks as the data comes, not into a buffer of the size the archive states: a
+    // corrupt or hostile size field would otherwise allocate (and zero) gigabytes up front.
+    std::vector<char> bytes;
+    constexpr size_t kChunk = size_t{1} << 20;
+    while (bytes.size() < stat.size) {
+      const size_t old_size = bytes.size();
+      bytes.resize(old_size + std::min<uint64_t>(kChunk, stat.size - old_size));
+      const zip_int64_t n = zip_fread(file, bytes.data() + old_size, bytes.size() - old_size);
       THROW_IF(n < 0, source << ": corrupt or truncated entry: " << zip_file_strerror(file));
+      bytes.resize(old_size + static_cast<size_t>(n));
       if (n == 0) break;
-      read += n;
     }
-    THROW_IF(read != static_cast<zip_int64_t>(bytes.size()),
-             source << ": truncated entry (" << read << " of " << bytes.size() << " bytes)");
+    THROW_IF(bytes.size() != stat.size,
+             source << ": truncated entry (" << bytes.size() << " of " << stat.size << " bytes)");
     // libzip checks the entry's CRC once a read reaches its end, not on the last byte asked for:
     // without this read, a corrupt deflate stream of the right length would be taken as data.
     char past_end = 0;

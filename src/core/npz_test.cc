@@ -1,8 +1,11 @@
 #include "src/core/npz.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 #include <zip.h>
 
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -190,12 +193,59 @@ TEST(Npz, ErrorsNameTheFile) {
   EXPECT_NE(ExpectThrowMessage([&] { ParseNpy(huge.data(), huge.size(), "huge.npy"); })
                 .find("huge.npy: malformed shape"),
             std::string::npos);
+  // String dtypes: a count that is missing, 0 (with a shape of 10^17 elements of no bytes) or
+  // too long for any number are named as unsupported, with the file.
+  for (const std::string descr : {"<U", "<U0", "<U99999999999999999999", ">U4", "<Ux"}) {
+    std::string strings = npy_of_shape("(100000000000000000,)");
+    strings.replace(strings.find("<f4"), 3, descr);
+    strings[8] = static_cast<char>(strings.size() - 10);  // the header's length, updated
+    const std::string message =
+        ExpectThrowMessage([&] { ParseNpy(strings.data(), strings.size(), "names.npy"); });
+    EXPECT_NE(message.find("names.npy: "), std::string::npos) << descr << ": " << message;
+    EXPECT_NE(message.find(descr), std::string::npos) << descr << ": " << message;
+  }
   // Unsupported dtype.
   std::string complex = npy;
   complex.replace(complex.find("<f4"), 3, "<c8");
   EXPECT_NE(ExpectThrowMessage([&] { ParseNpy(complex.data(), complex.size(), "cplx.npy"); })
                 .find("cplx.npy"),
             std::string::npos);
+}
+
+// An entry whose stated size (in the local header and the central directory) is 4 GB while it
+// holds 4 KB: an error naming the entry, without allocating what it states (1 GB of address
+// space is enough here; the buffer was once sized from the stated size).
+TEST(Npz, StatedSizeIsNotAllocatedUpFront) {
+  const std::string dir = MakeTestDir("stated_size");
+  const std::string path = JoinPaths(dir, "big.npz");
+  WriteStoredZip(path, "a.npy", FormatNpy(NpyArray::FromVector(std::vector<float>(1000, 0.5f))));
+  std::string zipped = ReadTextFile(path);
+  const std::string stated("\xfe\xff\xff\xff", 4);
+  for (const auto& [signature, size_offset] :
+       {std::pair<std::string, size_t>{"PK\x03\x04", 22}, {"PK\x01\x02", 24}}) {
+    const size_t at = zipped.find(signature);
+    ASSERT_NE(at, std::string::npos);
+    zipped.replace(at + size_offset, 4, stated);
+  }
+  WriteBytes(path, zipped);
+  EXPECT_EXIT(
+      {
+        rlimit limit{};
+        getrlimit(RLIMIT_AS, &limit);
+        limit.rlim_cur = std::min<rlim_t>(rlim_t{1} << 30, limit.rlim_max);
+        setrlimit(RLIMIT_AS, &limit);
+        try {
+          ReadNpz(path);
+        } catch (const Error& e) {
+          std::fprintf(stderr, "%s\n", e.what());
+          std::exit(std::string(e.what()).find("big.npz:a.npy: ") != std::string::npos ? 0 : 1);
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "%s\n", e.what());
+          std::exit(2);
+        }
+        std::exit(3);
+      },
+      ::testing::ExitedWithCode(0), "big.npz:a.npy");
 }
 
 // The shared data sets' files, written by numpy itself.
