@@ -159,6 +159,9 @@ GroundTruthStrands ReadGroundTruthStrands(const std::string& gt_path) {
   strands.points.resize(points.shape[0]);
   for (size_t i = 0; i < strands.points.size(); ++i) {
     strands.points[i] = Eigen::Vector3f(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+    THROW_IF(!strands.points[i].allFinite(),
+             points_path << ": point " << i << " is not finite (" << xyz[3 * i] << ", "
+                         << xyz[3 * i + 1] << ", " << xyz[3 * i + 2] << ")");
   }
   strands.offsets = offsets.ToVector<int64_t>(offsets_path);
   THROW_IF(strands.offsets.front() != 0 ||

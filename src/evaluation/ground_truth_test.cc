@@ -153,6 +153,12 @@ TEST(GroundTruth, FilesRoundTrip) {
   EXPECT_EQ(strands_back.offsets, strands.offsets);
   ASSERT_EQ(strands_back.points.size(), strands.points.size());
   EXPECT_EQ(strands_back.points[7], strands.points[7]);
+  // A point that is not finite is named with its file.
+  GroundTruthStrands stray = strands;
+  stray.points[7].y() = std::numeric_limits<float>::quiet_NaN();
+  WriteGroundTruthStrands(dir, stray);
+  const std::string error = testing_util::ErrorOf([&] { ReadGroundTruthStrands(dir); });
+  EXPECT_NE(error.find("strands_points.npy: point 7 is not finite"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -27,6 +27,8 @@ constexpr double kCurlyNoise = 0.25;
 // over the first 2 cm (or more, see rise_length_m) of its length.
 constexpr double kMinLayerM = 0.001;
 constexpr double kLayerSpanM = 0.014;
+// How far from the head's centre a given strand's point may lie (long hair hangs about 1 m).
+constexpr double kMaxHairReachM = 2.0;
 constexpr double kLayerRiseM = 0.02;
 
 Eigen::Vector3d RandomUnit(SplitMix64* rng) {
@@ -230,6 +232,15 @@ HairStrands HairFromStrands(const HeadModel& head, std::vector<Eigen::Vector3f> 
                offsets.back() != static_cast<int64_t>(points.size()),
            "HairFromStrands: the offsets must run from 0 to the number of points ("
                << points.size() << ")");
+  // Hair lies around the head: a point metres away (another unit, a stray value) would be
+  // densified into billions of points and leave the head unseen.
+  for (size_t k = 0; k < points.size(); ++k) {
+    const double reach_m = (points[k].cast<double>() - head.centre).norm();
+    THROW_IF(!(reach_m <= kMaxHairReachM),
+             "HairFromStrands: point " << k << " (" << points[k].transpose() << ") lies "
+                                       << reach_m << " m from the head's centre; strands lie "
+                                       << "within " << kMaxHairReachM << " m of it, in metres");
+  }
   HairStrands hair;
   hair.points = std::move(points);
   hair.offsets = std::move(offsets);
@@ -264,6 +275,18 @@ DenseStrands DensifyStrands(const HairStrands& hair, double max_spacing_m, doubl
                             double tip_diameter_m) {
   CHECK_GT(max_spacing_m, 0.0);
   const int n = hair.NumStrands();
+  double length_m = 0;
+  for (int s = 0; s < n; ++s) {
+    for (int64_t i = hair.offsets[s]; i + 1 < hair.offsets[s + 1]; ++i) {
+      length_m += (hair.points[i + 1] - hair.points[i]).norm();
+    }
+  }
+  // About 28 bytes per point: beyond this the renders would not fit in memory anyway.
+  constexpr double kMaxDensePoints = 5e8;
+  THROW_IF(length_m / max_spacing_m > kMaxDensePoints,
+           "DensifyStrands: " << hair.NumStrands() << " strands " << length_m
+                              << " m long in all would take " << length_m / max_spacing_m
+                              << " points at one per " << max_spacing_m << " m");
   auto segments = [&](int64_t i) {
     const double len = (hair.points[i + 1] - hair.points[i]).norm();
     return std::max<int64_t>(1, static_cast<int64_t>(std::ceil(len / max_spacing_m)));

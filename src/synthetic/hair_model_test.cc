@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <limits>
+
 #include "src/core/logging.h"
+#include "src/core/test_util.h"
 #include "src/evaluation/ground_truth.h"
 
 namespace hairmvs {
@@ -99,6 +102,17 @@ TEST(HairFromStrands, LayersFromHeightAboveScalpAndSeededAlbedo) {
   EXPECT_THROW(HairFromStrands(head, points, short_of_the_points, 3), Error);
   const std::vector<int64_t> one_point_strand = {0, 1, 10, 15};
   EXPECT_THROW(HairFromStrands(head, points, one_point_strand, 3), Error);
+  // A point far from the head (another unit, a stray value), or not finite, is named: it would
+  // be densified into billions of points.
+  for (const float far : {1e4f, std::numeric_limits<float>::infinity(),
+                          std::numeric_limits<float>::quiet_NaN()}) {
+    std::vector<Eigen::Vector3f> stray = points;
+    stray[7].x() = far;
+    const std::string error =
+        testing_util::ErrorOf([&] { HairFromStrands(head, stray, offsets, 3); });
+    EXPECT_NE(error.find("HairFromStrands: point 7 ("), std::string::npos) << error;
+    EXPECT_NE(error.find("within 2 m of it"), std::string::npos) << error;
+  }
 }
 
 // Curls make a strand much longer than the distance it covers.
@@ -145,6 +159,10 @@ TEST(DensifyStrands, KeepsStoredPointsFollowsSplineAndTapers) {
   const Eigen::Vector3d on_spline = CatmullRom(p0, p0, p1, p2, 0.5);
   const double d = DistanceToPolyline(dense.points, dense.offsets[0], dense.offsets[1], on_spline);
   EXPECT_LT(d, 2e-5);
+  // A spacing that would take more points than memory holds is refused before any is made.
+  const std::string error =
+      testing_util::ErrorOf([&] { DensifyStrands(hair, 1e-12, 1e-4, 1e-4); });
+  EXPECT_NE(error.find("points at one per 1e-12 m"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -166,8 +166,12 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
     GroundTruthStrands given = ReadGroundTruthStrands(options.strands_path);
     THROW_IF(given.NumStrands() == 0,
              "synthesize: no strands in " << options.strands_path << " (strands_offsets.npy)");
-    hair = HairFromStrands(head, std::move(given.points), std::move(given.offsets),
-                           static_cast<uint64_t>(options.seed));
+    try {
+      hair = HairFromStrands(head, std::move(given.points), std::move(given.offsets),
+                             static_cast<uint64_t>(options.seed));
+    } catch (const Error& e) {
+      HAIRMVS_THROW("synthesize: the strands of " << options.strands_path << ": " << e.what());
+    }
   }
   const Eigen::Vector3d hair_centre = hair.BoundingBoxCentre();
   DenseStrands dense = DensifyStrands(
