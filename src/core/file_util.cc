@@ -159,13 +159,19 @@ void RemoveTemporariesAndDie(int signal_number) {
   raise(signal_number);
 }
 
+// ".<stem>.tmp<pid>_<n><extension>" beside `path`: hidden, unique to this process, and with the
+// extension kept (OpenCV picks the image format by it). The stem is shortened where the name
+// would pass the file system's 255-byte limit, which a long name near it otherwise would.
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
+  constexpr size_t kMaxNameBytes = 255;
   const fs::path p(path);
-  std::ostringstream name;
-  name << "." << p.stem().string() << ".tmp" << getpid() << "_" << counter++
-       << p.extension().string();
-  return (p.parent_path() / name.str()).string();
+  std::ostringstream suffix;
+  suffix << ".tmp" << getpid() << "_" << counter++ << p.extension().string();
+  std::string stem = p.stem().string();
+  const size_t room = kMaxNameBytes - std::min(kMaxNameBytes, 1 + suffix.str().size());
+  if (stem.size() > room) stem.resize(room);
+  return (p.parent_path() / ("." + stem + suffix.str())).string();
 }
 
 void RenameOver(const std::string& tmp, const std::string& path) {

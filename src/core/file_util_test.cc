@@ -29,6 +29,16 @@ TEST(FileUtil, JoinPathsAppendsAsColmapDoes) {
   EXPECT_EQ(JoinPaths("", "/x/a.png"), "/x/a.png");
 }
 
+// A name near the file system's 255-byte limit (a photo's name with ".png" added, as a mask)
+// is written: its temporary name is shortened to fit, not longer than the name itself.
+TEST(FileUtil, AtomicWriteOfALongName) {
+  const std::string dir = MakeTestDir("long_name");
+  const std::string path = JoinPaths(dir, std::string(246, 'x') + ".jpg.png");
+  WriteFileAtomically(path, [](std::ostream& out) { out << "mask"; });
+  EXPECT_EQ(ReadTextFile(path), "mask");
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 1);
+}
+
 TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
   const std::string dir = MakeTestDir("atomic");
   const std::string path = JoinPaths(dir, "sub", "file.txt");
@@ -179,11 +189,15 @@ TEST(FileUtil, CopyFilesAtomicallyCopiesAllOrNone) {
 TEST(FileUtil, FailedWriteSaysWhy) {
   const std::string dir = MakeTestDir("failed_write");
   auto write = [](std::ostream& out) { out << "data"; };
-  // The temporary's name (".<name>.tmp<pid>_<n>.txt") is over the file system's 255 bytes.
-  const std::string long_path = JoinPaths(dir, std::string(250, 'a') + ".txt");
-  std::string message = testing_util::ErrorOf([&] { WriteFileAtomically(long_path, write); });
-  EXPECT_NE(message.find("Cannot write " + long_path + ": File name too long"),
-            std::string::npos)
+  // A folder where no file can be made, even by root.
+  const std::string in_proc = "/proc/hairmvs_failed_write.txt";
+  std::string message = testing_util::ErrorOf([&] { WriteFileAtomically(in_proc, write); });
+  EXPECT_EQ(message.find("Cannot write " + in_proc + ": "), 0u) << message;
+  // A name over the file system's 255 bytes: its temporary is shortened to fit, the rename
+  // cannot be.
+  const std::string long_path = JoinPaths(dir, std::string(256, 'a') + ".txt");
+  message = testing_util::ErrorOf([&] { WriteFileAtomically(long_path, write); });
+  EXPECT_NE(message.find("to " + long_path + ": File name too long"), std::string::npos)
       << message;
   // A folder in the way of the rename.
   const std::string folder = JoinPaths(dir, "target.txt");
