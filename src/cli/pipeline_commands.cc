@@ -80,10 +80,14 @@ int RunPipeline(int argc, char** argv) {
   THROW_IF(!stereo_options.Check(&error), "--OrientationStereo: " << error);
   THROW_IF(!fusion_options.Check(&error), "--TemplateFusion: " << error);
   THROW_IF(!source_options.Check(&error), "--SourceViews: " << error);
+  THROW_IF(stages.empty(), "--stages: no stage given (orientation, stereo, fusion)");
   for (const std::string& stage : stages) {
     THROW_IF(stage != "orientation" && stage != "stereo" && stage != "fusion",
              "--stages: unknown stage '" << stage << "' (orientation, stereo, fusion)");
   }
+  // Before colmap image_undistorter's minutes, not after them.
+  THROW_IF(ExistsFile(workspace_path),
+           "--workspace_path " << workspace_path << " is a file, not a folder");
 
   Timer total;
   StageTimings timings;

@@ -107,6 +107,17 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
   EXPECT_NE(output.text.find("--SourceViews: max_num_source_views must be >= 1"),
             std::string::npos)
       << output.text;
+  output = RunHairmvs("pipeline --workspace_path " + dir + " --stages ''");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--stages: no stage given"), std::string::npos) << output.text;
+  const std::string file = JoinPaths(dir, "a_file");
+  WriteFileAtomically(file, [](std::ostream& out) { out << "not a workspace"; });
+  output = RunHairmvs("pipeline --workspace_path " + file + " --image_path " + dir +
+                      " --input_path " + dir);
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--workspace_path " + file + " is a file, not a folder"),
+            std::string::npos)
+      << output.text;
   output = RunHairmvs("import_ground_truth --ground_truth_path " + dir + " --workspace_path " +
                       dir + " --output_path " + JoinPaths(dir, "out") + " --median_filter_px 101");
   EXPECT_NE(output.exit_code, 0);
