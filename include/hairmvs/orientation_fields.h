@@ -12,8 +12,9 @@
 namespace hairmvs {
 
 struct OrientationFieldOptions {
-  // Paper: 3 levels (full, 1/2, 1/4 resolution).
+  // Paper: 3 levels (full, 1/2, 1/4 resolution); at most kMaxLevels.
   int num_levels = 3;
+  static constexpr int kMaxLevels = 8;
   // Paper: 180 filters, 1 degree apart, theta in [0, pi).
   int num_orientations = 180;
   // K0(x, y) = (G_inner(x) - G_outer(x)) G_along(y): a ridge detector, narrow positive centre

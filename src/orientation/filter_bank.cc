@@ -22,7 +22,9 @@ bool OrientationFieldOptions::Check(std::string* error) const {
     if (error != nullptr) *error = message;
     return false;
   };
-  if (num_levels < 1 || num_levels > 8) return fail("num_levels must be in [1, 8]");
+  if (num_levels < 1 || num_levels > kMaxLevels) {
+    return fail("num_levels must be in [1, " + std::to_string(kMaxLevels) + "]");
+  }
   if (num_orientations < 2 || num_orientations > 720)
     return fail("num_orientations must be in [2, 720]");
   if (!(sigma_across_inner_px > 0) || !(sigma_across_outer_px > 0) || !(sigma_along_px > 0))

@@ -194,12 +194,26 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
   return levels;
 }
 
+std::string OrientationPicturePath(const Workspace& workspace, const std::string& name,
+                                   int level) {
+  const std::string bin_path = workspace.OrientationMapPath(name, level);
+  CHECK(bin_path.size() > 4 && bin_path.compare(bin_path.size() - 4, 4, ".bin") == 0);
+  return bin_path.substr(0, bin_path.size() - 4) + ".png";
+}
+
 void WriteOrientationFields(const Workspace& workspace, const std::string& name,
                             const std::string& provenance, const std::vector<FloatMap>& levels) {
   const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
   std::error_code error;
   std::filesystem::remove(provenance_path, error);
   THROW_IF(error, "Cannot remove " << provenance_path << ": " << error.message());
+  // Pictures of the fields these replace would show other fields (and count as up to date for
+  // a later --write_png 1): removed; the caller writes this run's, if asked.
+  for (int l = 0; l < OrientationFieldOptions::kMaxLevels; ++l) {
+    const std::string picture = OrientationPicturePath(workspace, name, l);
+    std::filesystem::remove(picture, error);
+    THROW_IF(error, "Cannot remove " << picture << ": " << error.message());
+  }
   // Each level's fingerprint is of the bytes this run wrote, not of the file after it (which
   // another run may have replaced already).
   std::string recorded = provenance;

@@ -16,6 +16,11 @@
 
 namespace hairmvs {
 
+// The picture of level `level` of `name`'s fields (`orientation_fields --write_png 1`):
+// <name>.l<k>.png beside the level's Mat.
+std::string OrientationPicturePath(const Workspace& workspace, const std::string& name,
+                                   int level);
+
 // The provenance of the fields of image `name` computed at width x height with `options`,
 // as the text of its provenance file. OrientationField.num_levels is left out: level k does
 // not depend on how many levels are computed. Throws naming the file if the image or its

@@ -52,11 +52,6 @@ void WriteOrientationPng(const std::string& path, const FloatMap& field) {
   WriteImage(path, bgr);
 }
 
-std::string PngPathFor(const std::string& bin_path) {
-  CHECK(bin_path.size() > 4 && bin_path.compare(bin_path.size() - 4, 4, ".bin") == 0);
-  return bin_path.substr(0, bin_path.size() - 4) + ".png";
-}
-
 }  // namespace
 
 std::string OrientationFieldsResult::BriefReport() const {
@@ -111,7 +106,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
       bool up_to_date = CachedOrientationFieldsHold(workspace, name, provenance, camera,
                                                     options.num_levels, &why_not);
       for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
-        up_to_date = ExistsFile(PngPathFor(workspace.OrientationMapPath(name, l)));
+        up_to_date = ExistsFile(OrientationPicturePath(workspace, name, l));
       }
       if (up_to_date) {
         progress.Stage("up to date (its provenance holds): kept");
@@ -135,7 +130,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     result.num_files_written += static_cast<int>(levels.size()) + 1;
     if (run_options.write_png) {
       for (int l = 0; l < static_cast<int>(levels.size()); ++l) {
-        WriteOrientationPng(PngPathFor(workspace.OrientationMapPath(name, l)), levels[l]);
+        WriteOrientationPng(OrientationPicturePath(workspace, name, l), levels[l]);
         ++result.num_files_written;
       }
     }

@@ -164,6 +164,16 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   OrientationFieldOptions narrow;
   narrow.sigma_along_px = 3;
   EXPECT_EQ(RunOrientationFields(root, narrow, run_options, nullptr).num_images, 2);
+  // Fields computed again without pictures take the old pictures away, so that a later
+  // --write_png 1 does not find them up to date beside fields they do not show.
+  run_options.write_png = false;
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr).num_images,
+            2);
+  EXPECT_FALSE(ExistsFile(OrientationPicturePath(Workspace::Read(root), "a.png", 0)));
+  run_options.write_png = true;
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr).num_images,
+            2);
+  EXPECT_TRUE(ExistsFile(OrientationPicturePath(Workspace::Read(root), "a.png", 2)));
   run_options.skip_up_to_date = false;
   again = RunOrientationFields(root, OrientationFieldOptions(), run_options, nullptr);
   EXPECT_EQ(again.num_images, 2);
