@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 
+#include "hairmvs/orientation_fields.h"
 #include "src/opencl/opencl_context.h"
 #include "src/stereo/stereo_test_util.h"
 
@@ -347,6 +348,14 @@ TEST(OrientationStereoOptions, NormalizationAndConfidenceOptions) {
   options.orientation_normalization_radius_px = 0;  // the paper's raw fields
   std::string error;
   EXPECT_TRUE(options.Check(&error)) << error;
+  // The pyramid the fields are computed with: refused here, by the options given, rather than
+  // later by the orientation fields' own num_levels, which the user did not set.
+  options = OrientationStereoOptions();
+  options.coarse_level = OrientationFieldOptions::kMaxLevels;
+  ExpectRefusedNaming(options, "coarse_level + 1 must be at most 8");
+  options = OrientationStereoOptions();
+  options.num_levels = OrientationFieldOptions::kMaxLevels + 1;
+  ExpectRefusedNaming(options, "num_levels");
 }
 
 // The defaults pass Check; a strand plane tilted 90 degrees or more (or less than 0) and a

@@ -194,6 +194,11 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
   if (mrf_icm_polish_iterations < 0) e << "mrf_icm_polish_iterations must be >= 0; ";
   if (coarse_level < -1) e << "coarse_level must be >= -1; ";
+  // The orientation fields are computed with PyramidLevels() levels.
+  if (PyramidLevels() > OrientationFieldOptions::kMaxLevels) {
+    e << "num_levels and coarse_level + 1 must be at most " << OrientationFieldOptions::kMaxLevels
+      << "; ";
+  }
   if (coarse_first_level < 0) e << "coarse_first_level must be >= 0; ";
   if (!(level0_weight_angle_deg >= 0 && level0_weight_angle_deg < 180)) {
     e << "level0_weight_angle_deg must be in [0, 180); ";
