@@ -310,11 +310,6 @@ bool SourceViewOptions::Check(std::string* error) const {
     e << "t_group_max_axis_angle_deg must be in (0, 45). ";
   }
   if (!(t_group_max_distance_ratio >= 1)) e << "t_group_max_distance_ratio must be >= 1. ";
-  if ((depth_min > 0) != (depth_max > 0)) {
-    e << "depth_min and depth_max must be set together (both > 0) or both left < 0. ";
-  } else if (depth_min > 0 && !(depth_max > depth_min)) {
-    e << "depth_max must be greater than depth_min. ";
-  }
   if (error != nullptr) *error = StripWhitespace(e.str());
   return e.str().empty();
 }
@@ -493,22 +488,6 @@ std::vector<std::string> ViewsLookingTheSameWay(const Workspace& ws, const std::
     if (direction.dot(ws.ImageByName(name).ViewingDirection()) >= min_cos) views.push_back(name);
   }
   return views;
-}
-
-DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,
-                         const SourceViewOptions& options) {
-  if (options.depth_min > 0 && options.depth_max > 0) {
-    DepthRange range;
-    range.min_m = options.depth_min;
-    range.max_m = options.depth_max;
-    return range;
-  }
-  const DepthRange range = ComputeDepthRange(ws.Model(), ws.ImageByName(image_name).image_id);
-  THROW_IF(range.num_points == 0,
-           "Image " << image_name << " in " << ws.Path()
-                    << " sees no sparse points in front of it: set the depth range manually "
-                       "(depth_min and depth_max)");
-  return range;
 }
 
 // ---------------------------------------------------------------------------------------------

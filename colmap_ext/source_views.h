@@ -65,10 +65,6 @@ struct SourceViewOptions {
   double t_group_max_axis_angle_deg = 20.0;
   double t_group_max_view_angle_deg = 30.0;
   double t_group_max_distance_ratio = 1.5;
-  // COLMAP's PatchMatchStereo.depth_min / depth_max (metres, all images); < 0 = from the
-  // sparse points (ComputeDepthRange).
-  double depth_min = -1.0;
-  double depth_max = -1.0;
 
   template <typename Visitor>
   void ForEachField(Visitor&& v) {
@@ -89,8 +85,6 @@ struct SourceViewOptions {
       "gantry T group: optical axes within this angle of the reference's");
     v("t_group_max_distance_ratio", &t_group_max_distance_ratio,
       "gantry T group: largest/smallest baseline length");
-    v("depth_min", &depth_min, "minimum depth in metres for all images (<0: from sparse points)");
-    v("depth_max", &depth_max, "maximum depth in metres for all images (<0: from sparse points)");
   }
   bool Check(std::string* error) const;
 };
@@ -138,10 +132,6 @@ DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id);
 // fewer than `min_points` observations are inside the mask.
 DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
                              const FloatMap& mask, int min_points = 10);
-// The depth range to use: options.depth_min / depth_max when both are set (> 0), else
-// ComputeDepthRange. Throws hairmvs::Error when neither gives a range.
-DepthRange DepthRangeFor(const Workspace& ws, const std::string& image_name,
-                         const SourceViewOptions& options);
 
 // The epipolar direction, modulo pi, at image point `point_px` of the reference: the direction
 // of the line through `point_px` and the source camera centre projected into the reference.

@@ -305,19 +305,6 @@ TEST(DepthRange, ColmapRuleAndOverrides) {
   const DepthRange none = ComputeDepthRange(model, 2);
   EXPECT_EQ(none.num_points, 0);
   EXPECT_EQ(none.min_m, -1);
-
-  const Workspace ws = WriteAndRead("depth", model);
-  SourceViewOptions options;
-  EXPECT_DOUBLE_EQ(DepthRangeFor(ws, "a.png", options).max_m, 125);
-  EXPECT_NE(ErrorOf([&] { DepthRangeFor(ws, "b.png", options); }).find("depth_min"),
-            std::string::npos);
-  options.depth_min = 0.3;
-  options.depth_max = 0.9;
-  EXPECT_DOUBLE_EQ(DepthRangeFor(ws, "b.png", options).min_m, 0.3);
-  options.depth_max = -1;
-  std::string error;
-  EXPECT_FALSE(options.Check(&error));
-  EXPECT_NE(error.find("depth_min"), std::string::npos);
 }
 
 TEST(DepthRange, InsideTheMaskOnlyWhenEnoughPointsAreInside) {

@@ -60,11 +60,7 @@ WorkspaceInfo ComputeWorkspaceInfo(const std::string& workspace_path,
         row.mask_error = e.what();
       }
     }
-    if (options.depth_min > 0 && options.depth_max > 0) {
-      row.depth_range = DepthRangeFor(ws, name, options);
-    } else {
-      row.depth_range = ComputeDepthRange(model, image.image_id);
-    }
+    row.depth_range = ComputeDepthRange(model, image.image_id);
     info.views.push_back(row);
   }
   info.selections = SelectSourceViews(ws, options);
@@ -97,7 +93,8 @@ std::string WorkspaceInfo::Report() const {
       out << " depth " << v.depth_range.min_m << "-" << v.depth_range.max_m << " from "
           << v.depth_range.num_points;
     } else {
-      out << " depth none (no sparse points: set depth_min/depth_max)";
+      out << " depth none (no sparse points: give the stereo --OrientationStereo.depth_min and "
+             "depth_max)";
     }
     out.unsetf(std::ios::fixed);
     out << std::setprecision(6) << "\n";
