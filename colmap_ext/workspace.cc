@@ -315,6 +315,9 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     cv::Mat nonzero = channels[c] != 0;
     cv::bitwise_or(keep, nonzero, keep);
   }
+  const int num_kept = cv::countNonZero(keep);
+  THROW_IF(num_kept == 0, "Mask " << path << " excludes every pixel (all zero at " << keep.cols
+                                  << "x" << keep.rows << ")");
   if (keep.cols != width || keep.rows != height) {
     // A mask of another size is taken as the same picture at another scale (COLMAP's fusion
     // rescales masks too). Another aspect ratio cannot line up with the image, e.g. a mask
@@ -331,8 +334,9 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     keep = resized;
   }
   THROW_IF(cv::countNonZero(keep) == 0,
-           "Mask " << path << " excludes every pixel (all zero at " << width << "x" << height
-                   << ")");
+           "Mask " << path << " keeps " << num_kept << " pixel(s) at its own size but none once "
+                   << "scaled to " << width << "x" << height
+                   << " (a smaller max_image_size than the mask's thinnest parts allow)");
   FloatMap map(width, height, 1, 0.0f);
   for (int r = 0; r < height; ++r) {
     const uint8_t* row = keep.ptr<uint8_t>(r);

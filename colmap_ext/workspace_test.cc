@@ -238,7 +238,18 @@ TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
   EXPECT_EQ(ones.Data(), std::vector<float>(6, 1.0f));
   const std::string zero = JoinPaths(dir, "zero.png");
   ASSERT_TRUE(cv::imwrite(zero, cv::Mat(3, 3, CV_8U, cv::Scalar(0))));
-  EXPECT_NE(ErrorOf([&] { ReadMask(zero, 3, 3); }).find("zero.png"), std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ReadMask(zero, 3, 3); }).find("zero.png excludes every pixel"),
+            std::string::npos);
+  // A mask whose one kept pixel falls between the samples of a smaller size (max_image_size)
+  // says so, rather than that it excludes every pixel.
+  cv::Mat one(4, 4, CV_8U, cv::Scalar(0));
+  one.at<uint8_t>(1, 1) = 255;
+  const std::string one_path = JoinPaths(dir, "one.png");
+  ASSERT_TRUE(cv::imwrite(one_path, one));
+  const std::string scaled = ErrorOf([&] { ReadMask(one_path, 2, 2); });
+  EXPECT_NE(scaled.find("one.png keeps 1 pixel(s) at its own size but none once scaled to 2x2"),
+            std::string::npos)
+      << scaled;
   // Scaled copies are read, with a pixel of rounding (960 x 640 at 160 px wide is 106.7 rows);
   // another aspect ratio is named with both sizes.
   const std::string wide = JoinPaths(dir, "wide.png");
