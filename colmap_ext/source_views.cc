@@ -546,6 +546,10 @@ std::vector<PatchMatchProblem> ReadPatchMatchConfig(const std::string& path,
         require_image(name, i);
         THROW_IF(name == problem.reference,
                  path << ":" << i + 1 << ": reference " << name << " lists itself as a source");
+        // Twice, a source would count as two views in the data term and the consistency test.
+        THROW_IF(std::find(problem.sources.begin(), problem.sources.end(), name) !=
+                     problem.sources.end(),
+                 path << ":" << i + 1 << ": source " << name << " is listed twice");
         problem.sources.push_back(name);
       }
     }

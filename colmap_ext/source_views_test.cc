@@ -203,6 +203,7 @@ TEST(SourceViews, MalformedConfigLinesNameFileAndLine) {
       {"z.png\nb.png\n", ":1: Image with name `z.png`"},
       {"a.png\nb.png\nb.png\n", "reference b.png has no sources line"},
       {"a.png\na.png\n", ":2: reference a.png lists itself"},
+      {"a.png\nb.png, b.png\n", ":2: source b.png is listed twice"},
       {"a.png\n__all__, 2\n", ":2: `__all__` takes no arguments"},
   };
   for (const auto& [text, expected] : cases) {

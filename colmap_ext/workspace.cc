@@ -73,6 +73,19 @@ int Workspace::ImageIdx(const std::string& name) const {
   return static_cast<int>(it - image_names_.begin());
 }
 
+std::vector<std::string> Workspace::SelectImages(
+    const std::vector<std::string>& requested) const {
+  if (requested.empty()) return image_names_;
+  std::vector<int> seen;
+  for (const std::string& name : requested) {
+    const int idx = ImageIdx(name);
+    THROW_IF(std::find(seen.begin(), seen.end(), idx) != seen.end(),
+             "Image `" << name << "` is given twice (--image_names)");
+    seen.push_back(idx);
+  }
+  return requested;
+}
+
 const Image& Workspace::ImageByName(const std::string& name) const {
   const Image* image = model_.FindImageByName(name);
   THROW_IF(image == nullptr,

@@ -29,6 +29,10 @@ class Workspace {
   // Image names in COLMAP's image_idx order (the order of the records in sparse/images.*).
   const std::vector<std::string>& ImageNames() const { return image_names_; }
   int ImageIdx(const std::string& name) const;  // throws for an unknown name
+  // The views a command works on: `requested` (--image_names) as given, or every image when it
+  // is empty. Throws for an unknown name, and for a name given twice (its maps would be
+  // computed twice, and it would count as two views).
+  std::vector<std::string> SelectImages(const std::vector<std::string>& requested) const;
   const Image& ImageByName(const std::string& name) const;
   // Throws (telling the user to run colmap image_undistorter) unless PINHOLE/SIMPLE_PINHOLE.
   const Camera& CameraOf(const std::string& name) const;

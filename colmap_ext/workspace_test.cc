@@ -28,6 +28,15 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_EQ(ws.ImageNames(), (std::vector<std::string>{"a.png", "b.png", "c.png"}));
   EXPECT_EQ(ws.ImageIdx("c.png"), 2);
   EXPECT_THROW(ws.ImageIdx("d.png"), Error);
+  // --image_names: every image when none is given, those given in their order, an unknown one
+  // or one given twice refused by name.
+  EXPECT_EQ(ws.SelectImages({}), ws.ImageNames());
+  EXPECT_EQ(ws.SelectImages({"c.png", "a.png"}), (std::vector<std::string>{"c.png", "a.png"}));
+  EXPECT_NE(ErrorOf([&] { ws.SelectImages({"a.png", "d.png"}); }).find("`d.png` does not exist"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([&] { ws.SelectImages({"a.png", "b.png", "a.png"}); })
+                .find("Image `a.png` is given twice"),
+            std::string::npos);
   EXPECT_EQ(ws.ImageByName("b.png").image_id, 2u);
   EXPECT_EQ(ws.CameraOf("b.png").CalibrationMatrix()(0, 0), 50.0);
   EXPECT_NO_THROW(ws.RequireUndistortedCameras());

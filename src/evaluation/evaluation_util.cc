@@ -87,10 +87,7 @@ bool CheckImageNames(const std::vector<std::string>& names, std::string* error) 
 std::vector<std::string> ViewsToEvaluate(
     const Workspace& ws, const std::vector<std::string>& requested,
     const std::function<std::string(const std::string&)>& path_of, const std::string& none_found) {
-  if (!requested.empty()) {
-    for (const std::string& name : requested) ws.ImageIdx(name);  // throws for unknown names
-    return requested;
-  }
+  if (!requested.empty()) return ws.SelectImages(requested);
   std::vector<std::string> names, missing;
   for (const std::string& name : ws.ImageNames()) {
     (ExistsFile(path_of(name)) ? names : missing).push_back(name);

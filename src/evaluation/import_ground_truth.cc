@@ -137,9 +137,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   THROW_IF(IsSameOrInside(workspace_path, output_path),
            "--output_path " << output_path << " contains the workspace " << workspace_path);
   const Workspace ws = Workspace::Read(workspace_path);
-  std::vector<std::string> names = options.image_names;
-  if (names.empty()) names = ws.ImageNames();
-  for (const std::string& name : names) ws.ImageIdx(name);  // throws for an unknown name
+  const std::vector<std::string> names = ws.SelectImages(options.image_names);
 
   // The frame of the new workspace: model, images, masks, configuration.
   CreateDirs(output_path);

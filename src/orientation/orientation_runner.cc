@@ -74,9 +74,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     ScopedStageTimer timer(timings, "read workspace");
     return Workspace::Read(workspace_path, run_options.mask_path);
   }();
-  std::vector<std::string> names = run_options.image_names;
-  if (names.empty()) names = workspace.ImageNames();
-  for (const auto& name : names) workspace.ImageIdx(name);  // throws for an unknown name
+  const std::vector<std::string> names = workspace.SelectImages(run_options.image_names);
 
   std::shared_ptr<OpenCLContext> context;
   std::unique_ptr<OrientationFieldComputer> computer;

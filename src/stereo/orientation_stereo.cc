@@ -473,8 +473,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   StageTimings local_timings;
   if (timings == nullptr) timings = &local_timings;
   const Workspace workspace = Workspace::Read(workspace_path, options.mask_path);
-  std::vector<std::string> names = image_names.empty() ? workspace.ImageNames() : image_names;
-  for (const std::string& name : names) workspace.ImageIdx(name);  // throws for unknown names
+  std::vector<std::string> names = workspace.SelectImages(image_names);
   workspace.RequireUndistortedCameras();
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
