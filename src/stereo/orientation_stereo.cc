@@ -612,6 +612,13 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           if (options.depth_max <= 0) depth_max = hull_max;
         }
       }
+      // One bound given and the other computed can cross; say which is which.
+      THROW_IF((options.depth_min > 0) != (options.depth_max > 0) && depth_min > 0 &&
+                   depth_max > 0 && !(depth_max > depth_min),
+               name << ": the depth range is empty: " << depth_min << " to " << depth_max
+                    << " m, " << (options.depth_min > 0 ? "depth_min" : "depth_max")
+                    << " given and the other bound from the " << range_source
+                    << "; give both bounds, or one on the other side");
       THROW_IF(!(depth_min > 0 && depth_max > depth_min),
                name << ": no depth range (too few sparse points seen by this view?); give "
                     << "--OrientationStereo.depth_min and depth_max");
@@ -870,6 +877,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     first_estimates.clear();
 
+    // Why waiting for the other views may not help: said with the advice to run again.
+    constexpr const char* kNoMapWhy =
+        "a view that is no reference of stereo/patch-match.cfg never gets a map";
     Progress filter_progress("consistency filter", static_cast<int>(to_filter.size()));
     for (size_t i = 0; i < to_filter.size(); ++i) {
       const std::string& name = to_filter[i];
@@ -889,7 +899,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         LOG(WARNING) << name << ": none of the views it is checked against (its sources and "
                      << "the run's views looking the same way) has a .photometric depth map "
                      << "yet; its .geometric map is unfiltered (run again with "
-                     << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+                     << "--OrientationStereo.geom_consistency_only 1 once they have; " << kNoMapWhy
+                     << ")";
         depth = maps.ref->depth;
         filtered = false;
       } else {
@@ -897,7 +908,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           LOG(WARNING) << name << ": " << others.size() << " of the " << maps.num_others
                        << " views it is checked against have a .photometric depth map yet; its "
                        << ".geometric map is only filtered (run again with "
-                       << "--OrientationStereo.geom_consistency_only 1 when all views are done)";
+                       << "--OrientationStereo.geom_consistency_only 1 once they have; "
+                       << kNoMapWhy << ")";
         }
         ScopedStageTimer timer(timings, "consistency");
         depth = FilterDepthMapByConsistency(*maps.ref, others,
