@@ -69,7 +69,7 @@ int RunWorkspaceInfo(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   std::string error;
   THROW_IF(!field_options.Check(&error), "invalid --OrientationField options: " << error);
-  THROW_IF(!stereo_options.Check(&error), "invalid --max_image_size: " << error);  // its only one
+  THROW_IF(!stereo_options.Check(&error), "invalid --max_image_size: " << error);  // its one stereo option
   Timer timer;
   const WorkspaceInfo info = ComputeWorkspaceInfo(workspace_path, mask_path, options);
   stereo_options.mask_path = mask_path;  // the fields' provenance names the masks
