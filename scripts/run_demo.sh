@@ -11,18 +11,21 @@ cd "$(dirname "$0")/.."
 bash scripts/build.sh hairmvs
 HAIRMVS=./build/src/cli/hairmvs
 start=$(date +%s)
-# A previous demo's output (a synthesised set has gt/meta.json) is replaced; any other folder is
-# left alone.
+# A previous demo's output (marked by the demo itself with .hairmvs_demo) or an empty folder is
+# replaced; any other folder is left alone, a data set of one's own (which has gt/meta.json as
+# the demo's does) included.
+MARK=.hairmvs_demo
 if [ -e "$OUT" ]; then
-  if [ -f "$OUT/gt/meta.json" ] || [ -z "$(ls -A "$OUT")" ]; then
+  if [ -f "$OUT/$MARK" ] || [ -z "$(ls -A "$OUT")" ]; then
     rm -rf "$OUT"
   else
-    echo "run_demo.sh: $OUT exists and is not a previous demo's output (no gt/meta.json);" \
+    echo "run_demo.sh: $OUT exists and is not a previous demo's output (no $MARK);" \
          "give another folder" >&2
     exit 1
   fi
 fi
 # The generator's defaults (960 x 640, 100 000 strands): one T group of 4 views of curly hair.
 $HAIRMVS synthesize --output_path "$OUT" --style curly --rig gantry --num_groups 1
+echo "made by scripts/run_demo.sh, which replaces this folder on its next run" > "$OUT/$MARK"
 $HAIRMVS pipeline --workspace_path "$OUT/dense" --ground_truth_path "$OUT/gt"
 echo "demo: synthesis + pipeline + evaluation in $(( $(date +%s) - start )) s; outputs in $OUT/dense"
