@@ -19,7 +19,7 @@ fi
 SET=$(realpath "$1")
 OUT=$2
 shift 2
-HAIRMVS=$(realpath "$(dirname "$0")/../build/src/cli/hairmvs")
+HAIRMVS=$(realpath -m "$(dirname "$0")/../build/src/cli/hairmvs")
 [ -x "$HAIRMVS" ] || { echo "error: $HAIRMVS is missing: run bash scripts/build.sh hairmvs" >&2; exit 1; }
 for d in "$SET/dense/images" "$SET/dense/sparse" "$SET/gt"; do
   [ -d "$d" ] || { echo "error: $d is missing (a data set: dense/ workspace and gt/)" >&2; exit 1; }
@@ -30,7 +30,10 @@ mkdir -p "$OUT/stereo"
 for d in images masks sparse; do
   if [ -e "$SET/dense/$d" ]; then ln -s "$SET/dense/$d" "$OUT/$d"; fi
 done
-cp "$SET"/dense/stereo/*.cfg "$OUT/stereo/"
+# The configuration files, where the set has them (orientation_stereo reads them if present).
+for cfg in "$SET"/dense/stereo/*.cfg; do
+  if [ -f "$cfg" ]; then cp "$cfg" "$OUT/stereo/"; fi
+done
 
 start=$(date +%s)
 "$HAIRMVS" orientation_stereo --workspace_path "$OUT" \
