@@ -1,6 +1,7 @@
 #include "src/opencl/opencl_context.h"
 
 #include <algorithm>
+#include <limits>
 #include <cctype>
 #include <cstdint>
 #include <cstdio>
@@ -218,7 +219,8 @@ std::shared_ptr<OpenCLContext> OpenCLContext::Create(const std::string& device_s
     }
     if (chosen < 0) chosen = 0;
   } else if (IsNumber(spec)) {
-    const long index = std::stol(spec);
+    // More digits than any device count has: out of range, not a std::stol overflow.
+    const long index = spec.size() > 9 ? std::numeric_limits<long>::max() : std::stol(spec);
     THROW_IF(index >= static_cast<long>(devices.size()),
              "--OpenCL.device " << spec << ": no such device index; there are " << devices.size()
                                 << " device(s):\n"

@@ -181,11 +181,16 @@ TEST(OpenCLContext, DeviceSelection) {
   EXPECT_EQ(OpenCLContext::Create("0")->DeviceName(), devices[0].device_name);
   EXPECT_EQ(OpenCLContext::Create(devices[0].device_name.substr(0, 6))->DeviceName(),
             devices[0].device_name);
-  try {
-    OpenCLContext::Create("999");
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--OpenCL.device 999"), std::string::npos) << e.what();
+  // An index past the devices, also one of more digits than a long holds.
+  for (const std::string index : {"999", "99999999999999999999"}) {
+    try {
+      OpenCLContext::Create(index);
+      FAIL() << "expected an error";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("--OpenCL.device " + index + ": no such device index"),
+                std::string::npos)
+          << e.what();
+    }
   }
   OpenCLOptions options;
   options.device = "no-such-device-xyz";
