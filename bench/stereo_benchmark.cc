@@ -1,7 +1,7 @@
 // Throughput of the stereo kernels on PoCL: the orientation and photometric cost volumes and
 // the guided filter for one block of depth slices at 960 x 640 (the gantry set's size), 3 source
 // views; the geometric pass's prior for a fine band of 16 labels and 8 other views' maps.
-// Run: ./build-stereo/bench/stereo_benchmark
+// Run: ./build/bench/stereo_benchmark
 
 #include <benchmark/benchmark.h>
 

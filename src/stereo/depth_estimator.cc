@@ -397,7 +397,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
         continue;
       }
       base_buffers.push_back(ReadOnlyBuffer(context, base[l]));
-      blocks.emplace_back(context->Context(), CL_MEM_READ_WRITE, sizeof(float) * n * block);
+      blocks.push_back(context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * n * block));
     }
     // Selecting sources: each cost's own volume (one after another in `source_volumes`), its
     // levels summed, until the selection.
