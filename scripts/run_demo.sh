@@ -5,7 +5,8 @@
 # the mesh against the ground truth. Everything goes to ./out/demo (override: $1).
 set -euo pipefail
 # $1 is taken from where the script is called, before it moves to the repository.
-OUT=$(realpath -m "${1:-$(dirname "$0")/../out/demo}")
+DEFAULT_OUT=$(realpath -m "$(dirname "$0")/../out/demo")
+OUT=$(realpath -m "${1:-$DEFAULT_OUT}")
 cd "$(dirname "$0")/.."
 # Only the command-line tool: the tests and benchmarks are built by scripts/run_tests.sh.
 bash scripts/build.sh hairmvs
@@ -13,10 +14,12 @@ HAIRMVS=./build/src/cli/hairmvs
 start=$(date +%s)
 # A previous demo's output (marked by the demo itself with .hairmvs_demo) or an empty folder is
 # replaced; any other folder is left alone, a data set of one's own (which has gt/meta.json as
-# the demo's does) included.
+# the demo's does) included. The default folder, ./out/demo, is the demo's own: replaced too
+# where an older demo made it without the mark.
 MARK=.hairmvs_demo
 if [ -e "$OUT" ]; then
-  if [ -f "$OUT/$MARK" ] || [ -z "$(ls -A "$OUT")" ]; then
+  if [ -f "$OUT/$MARK" ] || [ -z "$(ls -A "$OUT")" ] ||
+     { [ "$OUT" = "$DEFAULT_OUT" ] && [ -f "$OUT/gt/meta.json" ]; }; then
     rm -rf "$OUT"
   else
     echo "run_demo.sh: $OUT exists and is not a previous demo's output (no $MARK);" \
