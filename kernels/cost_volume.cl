@@ -89,7 +89,10 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
   const float oim = ref[plane + p];
   float total[SLICE_CHUNK];
   for (int i = 0; i < count; ++i) total[i] = 0.0f;
-  if (ore != 0.0f || oim != 0.0f) {
+  // r = |O_ref| > 0 (not only O_ref != 0: a denormal field's r underflows to 0, and ore / r
+  // would be NaN).
+  const float r = sqrt(ore * ore + oim * oim);
+  if (r > 0.0f) {
     float depth[SLICE_CHUNK];
     for (int i = 0; i < count; ++i) {
       const float v = label_base[p] + (float)(slice_begin + k0 + i) * label_step;
@@ -100,7 +103,6 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
     const float x = (float)col + 0.5f;
     const float y = (float)row + 0.5f;
     // O_ref = r exp(2i theta) and the strand direction (ct, st) = (cos theta, sin theta).
-    const float r = sqrt(ore * ore + oim * oim);
     const float c2 = ore / r;
     const float ct = sqrt(fmax(0.0f, 0.5f * (1.0f + c2)));
     const float st = copysign(sqrt(fmax(0.0f, 0.5f * (1.0f - c2))), oim);
@@ -134,6 +136,9 @@ __kernel void orientation_cost(__global const float* ref, int width, int height,
           const float px = ux / uz, py = uy / uz;
           const float dx = hx - px * hz;
           const float dy = hy - py * hz;
+          // A strand seen end-on in the source (its piece projects to a point) has no
+          // direction there: no term, as in the CPU reference.
+          if (!(dx * dx + dy * dy > 0.0f)) continue;
           const float scale = r / (dx * dx + dy * dy);
           total[i] -= m[15] * scale * ((dx * dx - dy * dy) * o.x + 2.0f * dx * dy * o.y);
         } else {

@@ -261,6 +261,7 @@ FloatMap OrientationCostCpu(const CostViewInput& ref, const std::vector<CostView
                        &ya);
             ProjectCpu(ref, sources[v], x_ref + dx, y_ref + dy, depth / (1 - g_dot_d), &xb,
                        &yb);
+            if (xb == xa && yb == ya) continue;  // seen end-on: no direction, no term
             carried = std::polar(std::abs(o_ref), 2.0 * std::atan2(yb - ya, xb - xa));
           }
           total -= sources[v].weight * (std::conj(carried) * o_src).real();
