@@ -37,8 +37,8 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
 bool CachedOrientationFieldsHold(const Workspace& workspace, const std::string& name,
                                  const std::string& provenance, const StereoCamera& camera,
                                  int num_levels, std::string* why_not);
-// The cached levels, where CachedOrientationFieldsHold; otherwise nullopt and `*why_not` as it
-// says.
+// The cached levels, where CachedOrientationFieldsHold and each level's bytes are those its
+// provenance recorded (their crc32); otherwise nullopt and `*why_not` says what differs.
 std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
     const StereoCamera& camera, int num_levels, std::string* why_not);

@@ -101,8 +101,11 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
     if (run_options.skip_up_to_date) {
       std::string why_not;
-      bool up_to_date = CachedOrientationFieldsHold(workspace, name, provenance, camera,
-                                                    options.num_levels, &why_not);
+      // Read and checked against the bytes their provenance recorded, as the stereo reads
+      // them: a damaged level is computed again here, not only when the stereo meets it.
+      bool up_to_date = ReadCachedOrientationFields(workspace, name, provenance, camera,
+                                                    options.num_levels, &why_not)
+                            .has_value();
       for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
         up_to_date = ExistsFile(OrientationPicturePath(workspace, name, l));
       }

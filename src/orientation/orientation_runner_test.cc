@@ -247,6 +247,13 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   EXPECT_NE(why_not.find("changed after their provenance was written (" + level0 + " is "),
             std::string::npos)
       << why_not;
+  // orientation_fields computes such a level again: it checks the bytes as the stereo does.
+  OrientationFieldsRunOptions a_only;
+  a_only.image_names = {"a.png"};
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), a_only, nullptr).num_images, 1);
+  EXPECT_EQ(ReadTextFile(level0), level0_bytes);
+  EXPECT_EQ(RunOrientationFields(root, OrientationFieldOptions(), a_only, nullptr).num_up_to_date,
+            1);
   WriteFileAtomically(level0, [&](std::ostream& out) { out << level0_bytes; });
   EXPECT_TRUE(read("a.png", OrientationFieldOptions(), &why_not).has_value()) << why_not;
   WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << provenance; }, false);
