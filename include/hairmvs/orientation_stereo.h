@@ -494,6 +494,8 @@ struct OrientationStereoOptions {
   // which of these changed).
   bool reuse_orientation_maps = true;
   bool write_orientation_maps = true;
+  // Also write coloured depth and normal pictures (PNG): each command's own --write_png, not
+  // an option of this section (one option for one thing).
   bool write_png = false;
   // Also write each view's coarse data term as first estimated (aggregated, all labels, before
   // the geometric prior and the hull bound) to stereo/cost_volumes/<name>.coarse.bin (a Mat on
@@ -605,7 +607,6 @@ struct OrientationStereoOptions {
       "reuse stereo/orientation_maps/*.l<k>.bin made from this image, mask, size and filter");
     v("write_orientation_maps", &write_orientation_maps,
       "write computed orientation fields to stereo/orientation_maps/");
-    v("write_png", &write_png, "also write coloured depth and normal pictures (PNG)");
     v("write_cost_volume", &write_cost_volume,
       "write the coarse data term to stereo/cost_volumes/ (for evaluate_data_term)");
   }

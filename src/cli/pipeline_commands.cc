@@ -150,7 +150,7 @@ int RunPipeline(int argc, char** argv) {
   }
   if (HasStage(stages, "stereo")) {
     announce("orientation stereo");
-    stereo_options.write_png = stereo_options.write_png || write_png;
+    stereo_options.write_png = write_png;
     const OrientationStereoResult result = RunOrientationStereo(
         workspace_path, image_names, stereo_options, &timings, opencl_options.device,
         &source_options, &orientation_options);

@@ -25,7 +25,6 @@ void PrintSummary(const OrientationStereoResult& result, const StageTimings& tim
 int RunOrientationStereoCommand(int argc, char** argv) {
   std::string workspace_path;
   std::vector<std::string> image_names;
-  bool write_png = false;
   OrientationStereoOptions options;
   SourceViewOptions source_options;
   OrientationFieldOptions field_options;
@@ -39,13 +38,12 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   parser.Add("image_names", &image_names,
              "comma-separated reference images (default: all), e.g. to share a workspace "
              "between processes");
-  parser.Add("write_png", &write_png, "also write coloured depth and normal pictures");
+  parser.Add("write_png", &options.write_png, "also write coloured depth and normal pictures");
   parser.AddSection("OrientationStereo", &options);
   parser.AddSection("SourceViews", &source_options);
   parser.AddSection("OrientationField", &field_options);
   parser.AddSection("OpenCL", &opencl_options);
   if (!parser.Parse(argc, argv)) return 0;
-  if (parser.WasGiven("write_png")) options.write_png = write_png;
   std::string error;
   THROW_IF(!opencl_options.Check(&error), "invalid --OpenCL options: " << error);
   std::printf("%s", parser.Values().c_str());
@@ -84,6 +82,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
                       "(--OrientationStereo.skip_existing 0 computes them all again).");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace", /*required=*/true);
   parser.Add("workspace_format", &workspace_format, "COLMAP (PMVS is not supported)");
+  parser.Add("write_png", &options.write_png, "also write coloured depth and normal pictures");
   parser.Add("PatchMatchStereo.max_image_size", &max_image_size,
              "longer side of the processing resolution (-1: full)");
   parser.Add("PatchMatchStereo.depth_min", &depth_min, "depth range start (-1: sparse points)");
