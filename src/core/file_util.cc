@@ -191,7 +191,7 @@ void WriteFileAtomically(const std::string& path,
   WriteFilesAtomically({{path, write, binary}});
 }
 
-void WriteFilesAtomically(const std::vector<FileToWrite>& files) {
+void WriteFilesAtomically(const std::vector<FileToWrite>& files, bool last_marks_complete) {
   std::vector<std::string> tmps;
   // Each temporary is tracked from before it is created until the last rename.
   std::vector<std::unique_ptr<TrackedTemporary>> tracked;
@@ -216,6 +216,14 @@ void WriteFilesAtomically(const std::vector<FileToWrite>& files) {
   } catch (...) {
     remove_temporaries_from(0);
     throw;
+  }
+  if (last_marks_complete && !files.empty()) {
+    std::error_code ec;
+    fs::remove(files.back().path, ec);
+    if (ec) {
+      remove_temporaries_from(0);
+      HAIRMVS_THROW("Cannot remove " << files.back().path << ": " << ec.message());
+    }
   }
   for (size_t i = 0; i < files.size(); ++i) {
     try {

@@ -51,8 +51,12 @@ struct FileToWrite {
 // their targets, in order. If any `write` throws, every temporary is removed and the exception
 // propagates; no target is touched. The renames are the one step that is not atomic as a whole
 // (POSIX has no rename of several files): a rename that fails leaves the targets before it
-// replaced, and removes the temporaries left.
-void WriteFilesAtomically(const std::vector<FileToWrite>& files);
+// replaced, and removes the temporaries left. With `last_marks_complete`, the last file is what
+// tells a reader the unit is whole: its old version is removed once every temporary is complete,
+// before the first rename, so that a run stopped between the renames leaves the unit without its
+// last file (to be made again) rather than new files beside an old one.
+void WriteFilesAtomically(const std::vector<FileToWrite>& files,
+                          bool last_marks_complete = false);
 // For writers that need a file name (OpenCV's imwrite): `write` receives a temporary path
 // with the same extension as `path`.
 void WritePathAtomically(const std::string& path,

@@ -164,6 +164,38 @@ TEST(FileUtil, WriteFilesAtomicallyReplacesAllOrNone) {
   EXPECT_EQ(testing_util::NumEntriesIn(dir), 4);
 }
 
+// With the last file marking the unit whole (a depth map beside its normal map): a rename that
+// fails before the last one leaves the unit without its last file, never the old last file
+// beside new others; a write that fails before any rename leaves everything as it was.
+TEST(FileUtil, WriteFilesAtomicallyWithTheLastFileMarkingTheUnit) {
+  const std::string dir = MakeTestDir("marked_unit");
+  const std::string normals = JoinPaths(dir, "normals.bin");
+  const std::string depths = JoinPaths(dir, "depths.bin");
+  auto write = [](const char* text) {
+    return [text](std::ostream& out) { out << text; };
+  };
+  WriteFilesAtomically({{normals, write("old normals")}, {depths, write("old depths")}}, true);
+  EXPECT_EQ(ReadTextFile(depths), "old depths");
+  EXPECT_THROW(WriteFilesAtomically({{normals, write("new normals")},
+                                     {depths,
+                                      [](std::ostream& out) {
+                                        out << "half" << std::flush;
+                                        throw std::runtime_error("disk full");
+                                      }}},
+                                    true),
+               std::runtime_error);
+  EXPECT_EQ(ReadTextFile(normals), "old normals");
+  EXPECT_EQ(ReadTextFile(depths), "old depths");
+  // The first rename fails (a folder where the normals go): the old depths are gone.
+  const std::string blocked = JoinPaths(dir, "blocked.bin");
+  CreateDirs(blocked);
+  EXPECT_THROW(WriteFilesAtomically({{blocked, write("new normals")}, {depths, write("new")}},
+                                    true),
+               Error);
+  EXPECT_FALSE(ExistsFile(depths));
+  EXPECT_EQ(testing_util::NumEntriesIn(dir), 2);  // normals.bin and the folder
+}
+
 // Copies as a unit (undistort_masks' masks): all are copied, empty files too, or, when a
 // source cannot be read, none, the source named.
 TEST(FileUtil, CopyFilesAtomicallyCopiesAllOrNone) {

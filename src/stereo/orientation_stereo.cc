@@ -437,14 +437,12 @@ void WriteDepthAndNormals(const Workspace& workspace, const std::string& name,
   const std::string depth_path = workspace.DepthMapPath(name, type);
   const std::string normal_path = workspace.NormalMapPath(name, type);
   const FloatMap normals = NormalMapFromDepthMap(depth, K);
-  // The pair as one unit for a resumed run (HasDepthAndNormals): the old depth map goes first
-  // and the new one is renamed into place last, so that a run stopped between the two renames
-  // leaves no depth map, and the view is computed again, rather than a new depth map beside
-  // the old normals.
-  std::error_code not_there;
-  std::filesystem::remove(depth_path, not_there);
+  // The pair as one unit for a resumed run (HasDepthAndNormals): the depth map marks it whole,
+  // so that a run stopped between the two renames leaves no depth map, and the view is computed
+  // again, rather than a new depth map beside the old normals (or the reverse).
   WriteFilesAtomically({{normal_path, [&](std::ostream& out) { WriteMat(out, normals); }},
-                        {depth_path, [&](std::ostream& out) { WriteMat(out, depth); }}});
+                        {depth_path, [&](std::ostream& out) { WriteMat(out, depth); }}},
+                       /*last_marks_complete=*/true);
   if (png) {
     WriteDepthPng(depth_path + ".png", depth);
     WriteNormalPng(normal_path + ".png", normals);
