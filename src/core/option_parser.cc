@@ -142,11 +142,9 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
   std::vector<std::string> args(argv + first, argv + argc);
   try {
     // No positional arguments: a word that is not an option (a value given twice, a
-    // forgotten "--") is an error rather than dropped.
-    po::store(po::command_line_parser(args)
-                  .options(impl_->desc)
-                  .positional(po::positional_options_description())
-                  .run(),
+    // forgotten "--") is an error rather than dropped. (The parser keeps a pointer to it.)
+    const po::positional_options_description no_positional;
+    po::store(po::command_line_parser(args).options(impl_->desc).positional(no_positional).run(),
               impl_->vm);
     if (impl_->vm.count("help")) {
       std::cout << Help();
