@@ -172,6 +172,15 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   // As colmap's filter 0: every estimate is kept; with geom_consistency the geometric pass still
   // estimates each view again with its sources' maps as a prior.
   if (!filter) {
+    // What filter 0 turns off, given explicitly as well, would be silently overridden.
+    for (const char* filtering :
+         {"OrientationStereo.filter_range_ends", "OrientationStereo.min_confidence",
+          "OrientationStereo.geom_consistency_min_views",
+          "PatchMatchStereo.filter_min_num_consistent"}) {
+      THROW_IF(parser.WasGiven(filtering),
+               "hairmvs patch_match_stereo: --PatchMatchStereo.filter 0 keeps every estimate; "
+               "--" << filtering << " filters them: give one or the other");
+    }
     options.filter_range_ends = false;
     options.min_confidence = 0;
     options.geom_consistency_min_views = 0;

@@ -175,6 +175,11 @@ TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
   EXPECT_NE(output.text.find("geometric consistency"), std::string::npos) << output.text;
   const long unfiltered = num_depths("geometric");
   EXPECT_GT(unfiltered, filtered);
+  // A filter given beside filter 0, which would override it, is refused before any work.
+  output = RunHairmvs(run + " --PatchMatchStereo.filter 0 --OrientationStereo.min_confidence 0.1");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--OrientationStereo.min_confidence filters them"), std::string::npos)
+      << output.text;
   output = RunHairmvs(run + " --PatchMatchStereo.max_image_size 0");
   EXPECT_NE(output.exit_code, 0);
   EXPECT_NE(output.text.find("(max_image_size is set by --PatchMatchStereo.max_image_size)"),
