@@ -74,37 +74,23 @@ std::string MeshEvaluationResult::Report() const {
   return out.str();
 }
 
-MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
-                                  const std::string& ground_truth_path,
-                                  const std::string& workspace_path,
-                                  const MeshEvaluationOptions& options,
-                                  StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
-  StageLaps laps(timings);
-  Timer timer;
-  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
-  const StrandDistance strand_distance(strands, options.strand_spacing_m);
-  LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
-            << timer.ElapsedSeconds() << " s)";
-  laps.Lap("true strands");
-  return EvaluateMesh(mesh_path, ground_truth_path, workspace_path, options, strand_distance,
-                      timings);
-}
+namespace {
 
-MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
-                                  const std::string& ground_truth_path,
-                                  const std::string& workspace_path,
-                                  const MeshEvaluationOptions& options,
-                                  const StrandDistance& strand_distance,
-                                  StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
-  StageLaps laps(timings);
-  const TriangleMesh mesh = ReadMeshPly(mesh_path);
+TriangleMesh ReadMeshToEvaluate(const std::string& mesh_path) {
+  TriangleMesh mesh = ReadMeshPly(mesh_path);
   THROW_IF(mesh.vertices.empty() || mesh.faces.empty(),
            mesh_path << ": the mesh has " << mesh.vertices.size() << " vertices and "
                      << mesh.faces.size() << " faces; a surface is needed");
+  return mesh;
+}
+
+MeshEvaluationResult EvaluateReadMesh(const TriangleMesh& mesh, const std::string& mesh_path,
+                                      const std::string& ground_truth_path,
+                                      const std::string& workspace_path,
+                                      const MeshEvaluationOptions& options,
+                                      const StrandDistance& strand_distance,
+                                      StageTimings* timings) {
+  StageLaps laps(timings);
   MeshEvaluationResult result;
   result.num_vertices = static_cast<long>(mesh.vertices.size());
   result.num_faces = static_cast<long>(mesh.faces.size());
@@ -187,6 +173,41 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   WriteJsonSummary(result.json_path, json);
   laps.Lap("completeness");
   return result;
+}
+
+}  // namespace
+
+MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
+                                  const std::string& ground_truth_path,
+                                  const std::string& workspace_path,
+                                  const MeshEvaluationOptions& options,
+                                  StageTimings* timings) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  // The mesh first: a missing or malformed one is named at once, not after the strands' index
+  // (seconds to minutes) is built.
+  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
+  StageLaps laps(timings);
+  Timer timer;
+  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
+  const StrandDistance strand_distance(strands, options.strand_spacing_m);
+  LOG(INFO) << "True strands indexed: " << strand_distance.NumSamples() << " samples ("
+            << timer.ElapsedSeconds() << " s)";
+  laps.Lap("true strands");
+  return EvaluateReadMesh(mesh, mesh_path, ground_truth_path, workspace_path, options,
+                          strand_distance, timings);
+}
+
+MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
+                                  const std::string& ground_truth_path,
+                                  const std::string& workspace_path,
+                                  const MeshEvaluationOptions& options,
+                                  const StrandDistance& strand_distance,
+                                  StageTimings* timings) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  return EvaluateReadMesh(ReadMeshToEvaluate(mesh_path), mesh_path, ground_truth_path,
+                          workspace_path, options, strand_distance, timings);
 }
 
 }  // namespace hairmvs
