@@ -214,8 +214,9 @@ NpyArray ParseNpy(const char* bytes, size_t size, const std::string& source) {
   THROW_IF(!array.dtype.empty() && array.dtype[0] == '>',
            source << ": big-endian dtype " << array.dtype << " is not supported");
   if (!array.dtype.empty() && array.dtype[0] == '=') array.dtype[0] = '<';
-  // Single-byte types are written "|u1"; accept "<u1" too.
-  if (array.dtype.size() == 3 && array.dtype[2] == '1' && array.dtype[0] == '<') {
+  // Single-byte types are written "|u1"; accept "<u1" too (not "<U1": one 4-byte character).
+  if (array.dtype.size() == 3 && array.dtype[2] == '1' && array.dtype[0] == '<' &&
+      array.dtype[1] != 'U') {
     array.dtype[0] = '|';
   }
   const bool is_string = array.dtype.size() > 1 && array.dtype[1] == 'U';

@@ -76,6 +76,14 @@ TEST(Npz, NpyRoundTripAllTypes) {
   EXPECT_EQ(names_back.Strings(),
             (std::vector<std::string>{"g0_c.png", "h10.png", "\xc3\xa9"}));
   EXPECT_THROW(names_back.ToVector<float>("names"), Error);
+  // Strings of at most one character ("<U1", as numpy writes them too; empty ones as well).
+  for (const std::vector<std::string>& short_names :
+       {std::vector<std::string>{"a", "b"}, std::vector<std::string>{"", ""}}) {
+    const std::string bytes = FormatNpy(NpyArray::FromStrings(short_names));
+    const NpyArray back = ParseNpy(bytes.data(), bytes.size(), "short.npy");
+    EXPECT_EQ(back.dtype, "<U1");
+    EXPECT_EQ(back.Strings(), short_names);
+  }
 
   const auto u1 = NpyArray::FromVector<uint8_t>({0, 1, 2, 255});
   const auto i4 = NpyArray::FromVector<int32_t>({-5, 7});
