@@ -204,28 +204,42 @@ std::string OrientationPicturePath(const Workspace& workspace, const std::string
 void WriteOrientationFields(const Workspace& workspace, const std::string& name,
                             const std::string& provenance, const std::vector<FloatMap>& levels) {
   const std::string provenance_path = workspace.OrientationMapProvenancePath(name);
+  // What the fields these replace were, level by level: a level written again with the same
+  // bytes (the stereo computing one more level than orientation_fields did) keeps its picture.
+  std::map<int, std::string> old_fingerprints;
+  if (ExistsFile(provenance_path)) {
+    std::string old_inputs;
+    SplitProvenanceFile(ReadTextFile(provenance_path), &old_inputs, &old_fingerprints);
+  }
   std::error_code error;
   std::filesystem::remove(provenance_path, error);
   THROW_IF(error, "Cannot remove " << provenance_path << ": " << error.message());
-  // Pictures of the fields these replace would show other fields (and count as up to date for
-  // a later --write_png 1): removed; the caller writes this run's, if asked.
+  // Each level's fingerprint is of the bytes this run writes, not of the file after it (which
+  // another run may have replaced already).
+  std::vector<std::string> data(levels.size()), fingerprints(levels.size());
+  for (size_t l = 0; l < levels.size(); ++l) {
+    std::ostringstream bytes;
+    WriteMat(bytes, levels[l]);
+    data[l] = bytes.str();
+    fingerprints[l] = FingerprintOf(data[l]);
+  }
+  // A picture of a level that changes, or is not written, would show other fields (and count as
+  // up to date for a later --write_png 1): removed; the caller writes this run's, if asked.
   for (int l = 0; l < OrientationFieldOptions::kMaxLevels; ++l) {
+    const bool same_bytes = l < static_cast<int>(levels.size()) && old_fingerprints.count(l) &&
+                            old_fingerprints.at(l) == fingerprints[l];
+    if (same_bytes) continue;
     const std::string picture = OrientationPicturePath(workspace, name, l);
     std::filesystem::remove(picture, error);
     THROW_IF(error, "Cannot remove " << picture << ": " << error.message());
   }
-  // Each level's fingerprint is of the bytes this run wrote, not of the file after it (which
-  // another run may have replaced already).
   std::string recorded = provenance;
   for (size_t l = 0; l < levels.size(); ++l) {
-    std::ostringstream bytes;
-    WriteMat(bytes, levels[l]);
-    const std::string data = bytes.str();
     WriteFileAtomically(workspace.OrientationMapPath(name, static_cast<int>(l)),
-                        [&data](std::ostream& out) {
-                          out.write(data.data(), static_cast<std::streamsize>(data.size()));
+                        [&](std::ostream& out) {
+                          out.write(data[l].data(), static_cast<std::streamsize>(data[l].size()));
                         });
-    recorded += LevelLine(static_cast<int>(l), FingerprintOf(data)) + "\n";
+    recorded += LevelLine(static_cast<int>(l), fingerprints[l]) + "\n";
   }
   WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << recorded; },
                       /*binary=*/false);

@@ -233,6 +233,20 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   EXPECT_EQ(written.rfind(provenance, 0), 0u) << written;
   EXPECT_NE(written.find("\nlevel 2 "), std::string::npos) << written;
   EXPECT_TRUE(read("a.png", OrientationFieldOptions(), &why_not).has_value()) << why_not;
+  // Written again with the same bytes (as the stereo does when it needs one level more), a
+  // level keeps its picture; a level whose bytes change loses it.
+  const std::string picture0 = OrientationPicturePath(workspace, "a.png", 0);
+  WriteFileAtomically(picture0, [](std::ostream& out) { out << "a picture of level 0"; });
+  const std::vector<FloatMap> levels =
+      computer.Compute(ReadImageGray(workspace.ImagePath("a.png")), FloatMap());
+  WriteOrientationFields(workspace, "a.png", provenance, levels);
+  EXPECT_TRUE(ExistsFile(picture0));
+  std::vector<FloatMap> changed = levels;
+  changed[0].Data()[0] += 1.0f;
+  WriteOrientationFields(workspace, "a.png", provenance, changed);
+  EXPECT_FALSE(ExistsFile(picture0));
+  WriteOrientationFields(workspace, "a.png", provenance, levels);
+  EXPECT_EQ(ReadTextFile(provenance_path), written);
   // A level that another run replaced after this provenance was written (the same size: the
   // payload tells) is not taken for this provenance's, nor is a provenance of an older hairmvs
   // that records no levels.
