@@ -141,11 +141,22 @@ void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
 bool OptionParser::Parse(int argc, char** argv, int first) {
   std::vector<std::string> args(argv + first, argv + argc);
   try {
-    // No positional arguments: a word that is not an option (a value given twice, a
-    // forgotten "--") is an error rather than dropped. (The parser keeps a pointer to it.)
-    const po::positional_options_description no_positional;
-    po::store(po::command_line_parser(args).options(impl_->desc).positional(no_positional).run(),
+    // A word that is not an option (a value given twice, a forgotten "--") is an error naming
+    // it rather than dropped: every positional word lands in a hidden option, refused below.
+    // (The parser keeps pointers to both descriptions.)
+    constexpr const char* kStray = "hairmvs-stray-word";
+    po::options_description with_stray;
+    with_stray.add(impl_->desc).add_options()(kStray, po::value<std::vector<std::string>>());
+    po::positional_options_description stray_words;
+    stray_words.add(kStray, -1);
+    po::store(po::command_line_parser(args).options(with_stray).positional(stray_words).run(),
               impl_->vm);
+    if (impl_->vm.count(kStray)) {
+      const std::vector<std::string> words = impl_->vm[kStray].as<std::vector<std::string>>();
+      HAIRMVS_THROW("hairmvs " << impl_->command << ": unexpected word '" << words.front()
+                                << "' (options are --name value or --name=value; see hairmvs "
+                                << impl_->command << " -h)");
+    }
     if (impl_->vm.count("help")) {
       std::cout << Help();
       return false;
