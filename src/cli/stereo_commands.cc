@@ -172,14 +172,19 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   // As colmap's filter 0: every estimate is kept; with geom_consistency the geometric pass still
   // estimates each view again with its sources' maps as a prior.
   if (!filter) {
-    // What filter 0 turns off, given explicitly as well, would be silently overridden.
+    // What filter 0 turns off, given explicitly as well, would be silently overridden: hairmvs's
+    // own options are refused; colmap's filter_min_num_consistent is ignored, as colmap does,
+    // with a warning (a script written for colmap may pass every option).
     for (const char* filtering :
          {"OrientationStereo.filter_range_ends", "OrientationStereo.min_confidence",
-          "OrientationStereo.geom_consistency_min_views",
-          "PatchMatchStereo.filter_min_num_consistent"}) {
+          "OrientationStereo.geom_consistency_min_views"}) {
       THROW_IF(parser.WasGiven(filtering),
                "hairmvs patch_match_stereo: --PatchMatchStereo.filter 0 keeps every estimate; "
                "--" << filtering << " filters them: give one or the other");
+    }
+    if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent")) {
+      LOG(WARNING) << "--PatchMatchStereo.filter_min_num_consistent is ignored with "
+                      "--PatchMatchStereo.filter 0, as colmap ignores it";
     }
     options.filter_range_ends = false;
     options.min_confidence = 0;
