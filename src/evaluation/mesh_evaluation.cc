@@ -186,8 +186,9 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
   THROW_IF(!options.Check(&error), error);
   // The mesh first: a missing or malformed one is named at once, not after the strands' index
   // (seconds to minutes) is built.
-  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
   StageLaps laps(timings);
+  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
+  laps.Lap("read mesh");
   Timer timer;
   const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
@@ -206,8 +207,11 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
-  return EvaluateReadMesh(ReadMeshToEvaluate(mesh_path), mesh_path, ground_truth_path,
-                          workspace_path, options, strand_distance, timings);
+  StageLaps laps(timings);
+  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
+  laps.Lap("read mesh");
+  return EvaluateReadMesh(mesh, mesh_path, ground_truth_path, workspace_path, options,
+                          strand_distance, timings);
 }
 
 }  // namespace hairmvs
