@@ -27,8 +27,10 @@ if [ -e "$OUT" ]; then
     exit 1
   fi
 fi
+# Marked first, so that a run stopped in the synthesis leaves a folder the next run replaces.
+mkdir -p "$OUT"
+echo "made by scripts/run_demo.sh, which replaces this folder on its next run" > "$OUT/$MARK"
 # The generator's defaults (960 x 640, 100 000 strands): one T group of 4 views of curly hair.
 $HAIRMVS synthesize --output_path "$OUT" --style curly --rig gantry --num_groups 1
-echo "made by scripts/run_demo.sh, which replaces this folder on its next run" > "$OUT/$MARK"
 $HAIRMVS pipeline --workspace_path "$OUT/dense" --ground_truth_path "$OUT/gt"
 echo "demo: synthesis + pipeline + evaluation in $(( $(date +%s) - start )) s; outputs in $OUT/dense"
