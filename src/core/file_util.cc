@@ -170,7 +170,12 @@ std::string TemporaryPathFor(const std::string& path) {
   suffix << ".tmp" << getpid() << "_" << counter++ << p.extension().string();
   std::string stem = p.stem().string();
   const size_t room = kMaxNameBytes - std::min(kMaxNameBytes, 1 + suffix.str().size());
-  if (stem.size() > room) stem.resize(room);
+  if (stem.size() > room) {
+    // Cut before a UTF-8 continuation byte's lead, so that the name stays valid UTF-8.
+    size_t cut = room;
+    while (cut > 0 && (static_cast<unsigned char>(stem[cut]) & 0xC0) == 0x80) --cut;
+    stem.resize(cut);
+  }
   return (p.parent_path() / ("." + stem + suffix.str())).string();
 }
 

@@ -37,6 +37,12 @@ TEST(FileUtil, AtomicWriteOfALongName) {
   WriteFileAtomically(path, [](std::ostream& out) { out << "mask"; });
   EXPECT_EQ(ReadTextFile(path), "mask");
   EXPECT_EQ(testing_util::NumEntriesIn(dir), 1);
+  // A name of two-byte characters (é): written too.
+  std::string accented;
+  for (int i = 0; i < 120; ++i) accented += "\xc3\xa9";
+  const std::string accented_path = JoinPaths(dir, accented + ".png");
+  WriteFileAtomically(accented_path, [](std::ostream& out) { out << "mask"; });
+  EXPECT_EQ(ReadTextFile(accented_path), "mask");
 }
 
 TEST(FileUtil, AtomicWriteReplacesOnlyWhenComplete) {
