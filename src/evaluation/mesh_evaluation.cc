@@ -76,11 +76,17 @@ std::string MeshEvaluationResult::Report() const {
 
 namespace {
 
-TriangleMesh ReadMeshToEvaluate(const std::string& mesh_path) {
+// Checks the options and reads the mesh (a surface), timed as its own stage.
+TriangleMesh ReadMeshToEvaluate(const std::string& mesh_path, const MeshEvaluationOptions& options,
+                                StageTimings* timings) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   TriangleMesh mesh = ReadMeshPly(mesh_path);
   THROW_IF(mesh.vertices.empty() || mesh.faces.empty(),
            mesh_path << ": the mesh has " << mesh.vertices.size() << " vertices and "
                      << mesh.faces.size() << " faces; a surface is needed");
+  laps.Lap("read mesh");
   return mesh;
 }
 
@@ -182,13 +188,10 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& workspace_path,
                                   const MeshEvaluationOptions& options,
                                   StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
   // The mesh first: a missing or malformed one is named at once, not after the strands' index
   // (seconds to minutes) is built.
+  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path, options, timings);
   StageLaps laps(timings);
-  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
-  laps.Lap("read mesh");
   Timer timer;
   const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
@@ -205,13 +208,8 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const MeshEvaluationOptions& options,
                                   const StrandDistance& strand_distance,
                                   StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
-  StageLaps laps(timings);
-  const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path);
-  laps.Lap("read mesh");
-  return EvaluateReadMesh(mesh, mesh_path, ground_truth_path, workspace_path, options,
-                          strand_distance, timings);
+  return EvaluateReadMesh(ReadMeshToEvaluate(mesh_path, options, timings), mesh_path,
+                          ground_truth_path, workspace_path, options, strand_distance, timings);
 }
 
 }  // namespace hairmvs
