@@ -208,6 +208,7 @@ namespace {
 // markers they hold.
 bool JpegIsComplete(const std::string& bytes) {
   const auto at = [&](size_t i) { return static_cast<uint8_t>(bytes[i]); };
+  const auto is_restart = [](uint8_t marker) { return marker >= 0xD0 && marker <= 0xD7; };
   size_t i = 2;  // after FF D8
   while (i + 1 < bytes.size()) {
     if (at(i) != 0xFF) {  // extraneous bytes before a marker, which libjpeg skips too
@@ -220,7 +221,7 @@ bool JpegIsComplete(const std::string& bytes) {
       continue;
     }
     if (marker == 0xD9) return true;
-    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // TEM, RSTn: no length
+    if (marker == 0x01 || is_restart(marker)) {  // TEM, RSTn: no length
       i += 2;
       continue;
     }
@@ -232,7 +233,7 @@ bool JpegIsComplete(const std::string& bytes) {
     // Entropy-coded data of the scan: up to the next FF that is neither FF 00 nor a restart.
     while (i + 1 < bytes.size()) {
       const uint8_t next = at(i + 1);
-      if (at(i) == 0xFF && next != 0x00 && !(next >= 0xD0 && next <= 0xD7) && next != 0xFF) break;
+      if (at(i) == 0xFF && next != 0x00 && next != 0xFF && !is_restart(next)) break;
       ++i;
     }
   }
