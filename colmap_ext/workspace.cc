@@ -346,11 +346,11 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     cv::Mat resized;
     cv::resize(keep, resized, cv::Size(width, height), 0, 0, cv::INTER_NEAREST);
     keep = resized;
+    THROW_IF(cv::countNonZero(keep) == 0,
+             "Mask " << path << " keeps " << num_kept << " pixel(s) at its own size but none "
+                     << "once scaled to " << width << "x" << height
+                     << " (a smaller max_image_size than the mask's thinnest parts allow)");
   }
-  THROW_IF(cv::countNonZero(keep) == 0,
-           "Mask " << path << " keeps " << num_kept << " pixel(s) at its own size but none once "
-                   << "scaled to " << width << "x" << height
-                   << " (a smaller max_image_size than the mask's thinnest parts allow)");
   FloatMap map(width, height, 1, 0.0f);
   for (int r = 0; r < height; ++r) {
     const uint8_t* row = keep.ptr<uint8_t>(r);
