@@ -27,6 +27,18 @@ size_t NumericItemSize(const std::string& dtype) {
   return 0;
 }
 
+// Characters per element of a string descr "<U<n>", n from 1 to kMaxNpyStringChars; 0 for any
+// other descr.
+size_t StringItemChars(const std::string& dtype) {
+  const std::string count = dtype.size() > 2 ? dtype.substr(2) : "";
+  if (dtype.rfind("<U", 0) != 0 || count.empty() || count.size() > 7 ||
+      count.find_first_not_of("0123456789") != std::string::npos) {
+    return 0;
+  }
+  const unsigned long chars = std::stoul(count);
+  return chars <= kMaxNpyStringChars ? chars : 0;
+}
+
 // The value of `key` in a numpy header dict, as raw text up to the next top-level comma.
 std::string HeaderValue(const std::string& header, const std::string& key,
                         const std::string& source) {
@@ -122,10 +134,9 @@ size_t NpyArray::NumElements() const {
 
 size_t NpyArray::ItemSize() const {
   if (IsString()) {
-    const std::string count = dtype.substr(2);
-    THROW_IF(count.empty() || count.find_first_not_of("0123456789") != std::string::npos,
-             "Unsupported numpy dtype " << dtype);
-    return 4 * std::stoul(count);
+    const size_t chars = StringItemChars(dtype);
+    THROW_IF(chars == 0, "Unsupported numpy dtype " << dtype);
+    return 4 * chars;
   }
   const size_t size = NumericItemSize(dtype);
   THROW_IF(size == 0, "Unsupported numpy dtype " << dtype);
@@ -222,15 +233,10 @@ NpyArray ParseNpy(const char* bytes, size_t size, const std::string& source) {
   const bool is_string = array.dtype.size() > 1 && array.dtype[1] == 'U';
   THROW_IF(!is_string && NumericItemSize(array.dtype) == 0,
            source << ": unsupported dtype " << array.dtype);
-  if (is_string) {
-    // "<U" and a character count of 1 to kMaxNpyStringChars (numpy writes at least <U1).
-    const std::string count = array.dtype.substr(2);
-    THROW_IF(array.dtype[0] != '<' || count.empty() || count.size() > 7 ||
-                 count.find_first_not_of("0123456789") != std::string::npos ||
-                 std::stoul(count) == 0 || std::stoul(count) > kMaxNpyStringChars,
-             source << ": unsupported dtype " << array.dtype << " (strings of 1 to "
-                    << kMaxNpyStringChars << " characters)");
-  }
+  // numpy writes at least <U1.
+  THROW_IF(is_string && StringItemChars(array.dtype) == 0,
+           source << ": unsupported dtype " << array.dtype << " (strings of 1 to "
+                  << kMaxNpyStringChars << " characters)");
   const std::string fortran = HeaderValue(header, "fortran_order", source);
   THROW_IF(fortran != "False",
            source << ": Fortran-order arrays are not supported (fortran_order = " << fortran
