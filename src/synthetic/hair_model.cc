@@ -275,21 +275,13 @@ DenseStrands DensifyStrands(const HairStrands& hair, double max_spacing_m, doubl
                             double tip_diameter_m) {
   CHECK_GT(max_spacing_m, 0.0);
   const int n = hair.NumStrands();
-  double length_m = 0;
-  for (int s = 0; s < n; ++s) {
-    for (int64_t i = hair.offsets[s]; i + 1 < hair.offsets[s + 1]; ++i) {
-      length_m += (hair.points[i + 1] - hair.points[i]).norm();
-    }
-  }
   // About 28 bytes per point: beyond this the renders would not fit in memory anyway.
-  constexpr double kMaxDensePoints = 5e8;
-  THROW_IF(length_m / max_spacing_m > kMaxDensePoints,
-           "DensifyStrands: " << hair.NumStrands() << " strands " << length_m
-                              << " m long in all would take " << length_m / max_spacing_m
-                              << " points at one per " << max_spacing_m << " m");
+  constexpr int64_t kMaxDensePoints = 500'000'000;
   auto segments = [&](int64_t i) {
     const double len = (hair.points[i + 1] - hair.points[i]).norm();
-    return std::max<int64_t>(1, static_cast<int64_t>(std::ceil(len / max_spacing_m)));
+    // Clamped, as a larger double would not convert; a total past the limit is refused below.
+    return static_cast<int64_t>(std::clamp(std::ceil(len / max_spacing_m), 1.0,
+                                           static_cast<double>(kMaxDensePoints) + 1));
   };
   DenseStrands dense;
   dense.offsets.assign(n + 1, 0);
@@ -298,6 +290,9 @@ DenseStrands DensifyStrands(const HairStrands& hair, double max_spacing_m, doubl
     for (int64_t i = hair.offsets[s]; i + 1 < hair.offsets[s + 1]; ++i) count += segments(i);
     dense.offsets[s + 1] = dense.offsets[s] + count;
   }
+  THROW_IF(dense.offsets[n] > kMaxDensePoints,
+           "DensifyStrands: " << n << " strands would take more than " << kMaxDensePoints
+                              << " points at one per " << max_spacing_m << " m");
   dense.points.resize(dense.offsets[n]);
   dense.radius_m.resize(dense.offsets[n]);
   dense.strand.resize(dense.offsets[n]);
