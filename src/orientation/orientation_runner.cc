@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "colmap_ext/mat_io.h"
@@ -99,37 +100,48 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     const StereoCamera camera = workspace.ViewCamera(name);
     const std::string provenance =
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
+    // The cached levels, read and checked against the bytes their provenance recorded, as the
+    // stereo reads them: a damaged level is computed again here, not only when the stereo
+    // meets it.
+    std::optional<std::vector<FloatMap>> cached;
     if (run_options.skip_up_to_date) {
       std::string why_not;
-      // Read and checked against the bytes their provenance recorded, as the stereo reads
-      // them: a damaged level is computed again here, not only when the stereo meets it.
-      bool up_to_date = ReadCachedOrientationFields(workspace, name, provenance, camera,
-                                                    options.num_levels, &why_not)
-                            .has_value();
-      for (int l = 0; l < options.num_levels && up_to_date && run_options.write_png; ++l) {
-        up_to_date = ExistsFile(OrientationPicturePath(workspace, name, l));
+      cached = ReadCachedOrientationFields(workspace, name, provenance, camera,
+                                           options.num_levels, &why_not);
+      bool pictures = true;
+      for (int l = 0; l < options.num_levels && cached && run_options.write_png; ++l) {
+        pictures = pictures && ExistsFile(OrientationPicturePath(workspace, name, l));
       }
-      if (up_to_date) {
+      if (cached && pictures) {
         progress.Stage("up to date (its provenance holds): kept");
         ++result.num_up_to_date;
         continue;
       }
       if (!why_not.empty()) progress.Stage(why_not + ": computing them again");
     }
-    FloatMap gray, mask;
-    {
-      ScopedStageTimer timer(timings, "read image");
-      gray = workspace.ReadViewGray(name);
-      const std::string mask_path = workspace.MaskPath(name);
-      if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
+    std::vector<FloatMap> levels;
+    if (cached) {
+      // Only the pictures are missing: drawn from the fields read, not from the filter bank's
+      // work done again.
+      levels = std::move(*cached);
+      progress.Stage("up to date, pictures missing: writing them");
+    } else {
+      FloatMap gray, mask;
+      {
+        ScopedStageTimer timer(timings, "read image");
+        gray = workspace.ReadViewGray(name);
+        const std::string mask_path = workspace.MaskPath(name);
+        if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
+      }
+      progress.Stage("filter bank");
+      levels = computer->Compute(gray, mask);
+      progress.Stage("write");
+      ScopedStageTimer timer(timings, "write");
+      WriteOrientationFields(workspace, name, provenance, levels);
+      result.num_files_written += static_cast<int>(levels.size()) + 1;
     }
-    progress.Stage("filter bank");
-    const std::vector<FloatMap> levels = computer->Compute(gray, mask);
-    progress.Stage("write");
-    ScopedStageTimer timer(timings, "write");
-    WriteOrientationFields(workspace, name, provenance, levels);
-    result.num_files_written += static_cast<int>(levels.size()) + 1;
     if (run_options.write_png) {
+      ScopedStageTimer timer(timings, "write");
       for (int l = 0; l < static_cast<int>(levels.size()); ++l) {
         WriteOrientationPng(OrientationPicturePath(workspace, name, l), levels[l]);
         ++result.num_files_written;
