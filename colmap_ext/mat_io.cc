@@ -135,10 +135,12 @@ CostVolume ReadCostVolume(const std::string& path, const std::string& depths_pat
              depths_path << ":" << i + 1 << ": not a positive depth: '" << line << "'");
     // The labels' depths run one way (the evaluation interpolates between neighbours).
     const std::vector<double>& d = volume.label_depths;
-    THROW_IF(!d.empty() && (depth == d.back() ||
-                            (d.size() >= 2 && (depth > d.back()) != (d.back() > d[d.size() - 2]))),
-             depths_path << ":" << i + 1 << ": the label depths must run strictly one way; "
-                         << line << " follows " << d.back());
+    if (!d.empty()) {
+      const bool increasing = d.size() < 2 ? depth > d.back() : d.back() > d[d.size() - 2];
+      THROW_IF(depth == d.back() || (depth > d.back()) != increasing,
+               depths_path << ":" << i + 1 << ": the label depths must run strictly one way; "
+                           << line << " follows " << d.back());
+    }
     volume.label_depths.push_back(depth);
   }
   THROW_IF(static_cast<int>(volume.label_depths.size()) != volume.cost.Channels(),
