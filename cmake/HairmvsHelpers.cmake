@@ -33,6 +33,9 @@ function(hairmvs_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 600)
   endif()
+  # The colmap runs under test log beside CTest's own logs: glog's default is the machine's
+  # /tmp, four files a run (colmap sets logtostderr itself, so only the folder can be moved).
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}")
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
+               ENVIRONMENT "GLOG_log_dir=${CMAKE_BINARY_DIR}/Testing/Temporary")
 endfunction()
