@@ -35,7 +35,9 @@ function(hairmvs_add_test name)
   endif()
   # The colmap runs under test log beside CTest's own logs: glog's default is the machine's
   # /tmp, four files a run (colmap sets logtostderr itself, so only the folder can be moved).
+  # LABELS last: an empty one is dropped from the list, and would take the next key as its value.
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT ${ARG_TIMEOUT} LABELS "${ARG_LABELS}"
-               ENVIRONMENT "GLOG_log_dir=${CMAKE_BINARY_DIR}/Testing/Temporary")
+    PROPERTIES TIMEOUT ${ARG_TIMEOUT}
+               ENVIRONMENT "GLOG_log_dir=${CMAKE_BINARY_DIR}/Testing/Temporary"
+               LABELS "${ARG_LABELS}")
 endfunction()
