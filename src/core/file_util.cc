@@ -7,10 +7,15 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <mutex>
+#include <random>
+#include <regex>
+#include <set>
 #include <sstream>
 
 #include "src/core/logging.h"
@@ -159,15 +164,43 @@ void RemoveTemporariesAndDie(int signal_number) {
   raise(signal_number);
 }
 
-// ".<stem>.tmp<pid>_<n><extension>" beside `path`: hidden, unique to this process, and with the
-// extension kept (OpenCV picks the image format by it). The stem is shortened where the name
-// would pass the file system's 255-byte limit, which a long name near it otherwise would.
+std::string HostName() {
+  char name[256] = {};
+  if (gethostname(name, sizeof(name) - 1) != 0 || name[0] == '\0') return "localhost";
+  return name;
+}
+
+// Eight hex digits drawn once per process: with the pid and the host, a temporary's name is
+// unique to its process even among jobs in containers (a PID namespace each, so the same pids)
+// writing into one shared workspace.
+const std::string& ProcessToken() {
+  static const std::string token = [] {
+    std::random_device random;
+    char hex[9];
+    std::snprintf(hex, sizeof(hex), "%08x", static_cast<unsigned>(random()));
+    return std::string(hex);
+  }();
+  return token;
+}
+
+// Whether the process `pid` of this host has ended (not merely exited unreaped: kill still
+// finds a zombie, so its files are left until the next run).
+bool ProcessEnded(long pid) {
+  return pid != getpid() && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
+}
+
+// ".<stem>.tmp<pid>_<n>_<token>@<host><extension>" beside `path`: hidden, unique to this process
+// (ProcessToken), with the process and host that a later run needs to tell whether it was left
+// by a run that was killed (RemoveTemporariesOfEndedRuns), and with the extension kept (OpenCV
+// picks the image format by it). The stem is shortened where the name would pass the file
+// system's 255-byte limit, which a long name near it otherwise would.
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
   constexpr size_t kMaxNameBytes = 255;
   const fs::path p(path);
   std::ostringstream suffix;
-  suffix << ".tmp" << getpid() << "_" << counter++ << p.extension().string();
+  suffix << ".tmp" << getpid() << "_" << counter++ << "_" << ProcessToken() << "@" << HostName()
+         << p.extension().string();
   std::string stem = p.stem().string();
   const size_t room = kMaxNameBytes - std::min(kMaxNameBytes, 1 + suffix.str().size());
   if (stem.size() > room) {
@@ -177,6 +210,49 @@ std::string TemporaryPathFor(const std::string& path) {
     stem.resize(cut);
   }
   return (p.parent_path() / ("." + stem + suffix.str())).string();
+}
+
+// The process of this host that made the temporary file `name` (TemporaryPathFor), or -1 for a
+// name of another host or no temporary's. A name of the older form without token and host,
+// ".<stem>.tmp<pid>_<n><extension>", counts as this host's, as ScratchDir's do.
+long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) {
+  static const std::regex kCurrent(R"(\..*\.tmp([0-9]{1,9})_[0-9]+_[0-9a-f]{8})");
+  static const std::regex kOlder(R"(\..*\.tmp([0-9]{1,9})_[0-9]+)");
+  const std::string extension = fs::path(name).extension().string();
+  std::smatch match;
+  for (const std::string& end : {"@" + host + extension, "@" + host}) {
+    if (name.size() > end.size() && name.compare(name.size() - end.size(), end.size(), end) == 0) {
+      const std::string front = name.substr(0, name.size() - end.size());
+      if (std::regex_match(front, match, kCurrent)) return std::stol(match[1].str());
+    }
+  }
+  if (name.find('@') != std::string::npos) return -1;
+  const std::string front = name.substr(0, name.size() - extension.size());
+  if (std::regex_match(front, match, kOlder)) return std::stol(match[1].str());
+  return -1;
+}
+
+// Removes from `folder` the temporary files that runs of this host left when killed (SIGKILL
+// by a scheduler or the OOM killer, which no handler sees), once per folder and process: the
+// first write there. Those of running processes and of other hosts are left.
+void RemoveTemporariesOfEndedRuns(const std::string& folder) {
+  static std::mutex mutex;
+  static std::set<std::string> done;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!done.insert(folder).second) return;
+  }
+  const std::string host = HostName();
+  std::error_code ec;
+  for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || name[0] != '.' || !entry.is_regular_file(ec)) continue;
+    const long pid = TemporaryOwnerOnThisHost(name, host);
+    if (pid <= 0 || !ProcessEnded(pid)) continue;
+    LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
+              << ") that was stopped";
+    fs::remove(entry.path(), ec);
+  }
 }
 
 void RenameOver(const std::string& tmp, const std::string& path) {
@@ -207,6 +283,7 @@ void WriteFilesAtomically(const std::vector<FileToWrite>& files, bool last_marks
   try {
     for (const FileToWrite& file : files) {
       CreateDirs(ParentPath(file.path));
+      RemoveTemporariesOfEndedRuns(ParentPath(file.path));
       tmps.push_back(TemporaryPathFor(file.path));
       const std::string& tmp = tmps.back();
       tracked.push_back(std::make_unique<TrackedTemporary>(tmp));
@@ -243,6 +320,7 @@ void WriteFilesAtomically(const std::vector<FileToWrite>& files, bool last_marks
 void WritePathAtomically(const std::string& path,
                          const std::function<void(const std::string& tmp_path)>& write) {
   CreateDirs(ParentPath(path));
+  RemoveTemporariesOfEndedRuns(ParentPath(path));
   const std::string tmp = TemporaryPathFor(path);
   const TrackedTemporary tracked(tmp);
   try {
@@ -274,12 +352,6 @@ void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>&
 
 namespace {
 
-std::string HostName() {
-  char name[256] = {};
-  if (gethostname(name, sizeof(name) - 1) != 0 || name[0] == '\0') return "localhost";
-  return name;
-}
-
 // Removes the folders <prefix><pid>_<n>@<host> in `parent` whose process on this host has ended
 // (see ScratchDir). A name without "@<host>" (made before hosts were named) counts as this
 // host's.
@@ -295,7 +367,7 @@ void RemoveScratchOfEndedRuns(const std::string& parent, const std::string& pref
     const size_t at = rest.find('@', digits);
     if (at != std::string::npos && rest.substr(at + 1) != host) continue;
     const long pid = std::stol(rest.substr(0, digits));
-    if (pid == getpid() || kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    if (!ProcessEnded(pid)) continue;
     LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid
               << ") that was stopped";
     fs::remove_all(entry.path(), ec);

@@ -9,6 +9,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 #include "src/core/logging.h"
@@ -282,6 +283,48 @@ TEST(FileUtil, ScratchDirRemovesTheFoldersOfEndedRunsOfThisHost) {
     EXPECT_EQ(scratch.Path().substr(scratch.Path().size() - host.size() - 1), "@" + host);
   }
   EXPECT_EQ(testing_util::NumEntriesIn(dir), static_cast<int>(kept.size()));
+}
+
+// A temporary's name holds its process, a token drawn per process and its host, so that jobs in
+// containers (the same pids) writing into one workspace do not share names. The first write
+// into a folder removes the temporaries that killed runs of this host left there; those of
+// running processes and of other hosts, and other hidden files, are kept.
+TEST(FileUtil, AtomicWriteRemovesTheTemporariesOfEndedRunsOfThisHost) {
+  const std::string dir = MakeTestDir("ended_temporaries");
+  char host_name[256] = {};
+  ASSERT_EQ(gethostname(host_name, sizeof(host_name) - 1), 0);
+  const std::string host = host_name;
+  const pid_t ended = fork();
+  if (ended == 0) _exit(0);
+  ASSERT_EQ(waitpid(ended, nullptr, 0), ended);
+  const std::string gone = std::to_string(ended);
+  const std::vector<std::string> removed = {
+      ".a.tmp" + gone + "_3_0123abcd@" + host + ".bin",
+      ".b.tmp" + gone + "_0_89abcdef@" + host,  // no extension
+      ".c.png.tmp" + gone + "_7.png"};          // the older form, without token and host
+  const std::vector<std::string> kept = {
+      ".a.tmp1_0_0123abcd@" + host + ".bin",                 // init's: running
+      ".a.tmp" + gone + "_0_0123abcd@another-" + host + ".bin",  // another host's
+      ".a.tmpx_0.bin",                                         // not a temporary's name
+      ".hidden"};
+  for (const auto* names : {&removed, &kept}) {
+    for (const std::string& name : *names) {
+      std::ofstream(JoinPaths(dir, name)) << "left";
+    }
+  }
+  std::string temporary;
+  WritePathAtomically(JoinPaths(dir, "new.bin"), [&](const std::string& tmp_path) {
+    temporary = tmp_path;
+    std::ofstream(tmp_path) << "new";
+  });
+  for (const std::string& name : removed) EXPECT_FALSE(ExistsFile(JoinPaths(dir, name))) << name;
+  for (const std::string& name : kept) EXPECT_TRUE(ExistsFile(JoinPaths(dir, name))) << name;
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "new.bin")), "new");
+  const std::string own = JoinPaths(dir, ".new.tmp" + std::to_string(getpid()) + "_");
+  EXPECT_EQ(temporary.rfind(own, 0), 0u) << temporary;
+  const std::string end = "@" + host + ".bin";
+  ASSERT_GT(temporary.size(), end.size());
+  EXPECT_EQ(temporary.substr(temporary.size() - end.size()), end) << temporary;
 }
 
 // A folder this process may not write to is named before any work; a missing one is made.
