@@ -486,7 +486,9 @@ struct OrientationStereoOptions {
   // whose .geometric depth and normal maps exist is skipped, and one whose .photometric maps
   // exist starts at the geometric pass, so that an interrupted run resumes where it stopped.
   // Off by default for orientation_stereo: maps already there are those of the options they
-  // were made with, not of this run's.
+  // were made with, not of this run's. A view estimated again loses its .geometric maps when
+  // its new .photometric ones are written. Refused with geom_consistency_only, which redoes the
+  // .geometric maps that the first pass wrote.
   bool skip_existing = false;
   // Reuse / write stereo/orientation_maps/<name>.l<k>.bin. Cached fields are reused only while
   // their <name>.provenance.txt matches the image, the mask, the processing size and the

@@ -171,6 +171,13 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (geom_consistency_only && !geom_consistency) {
     e << "geom_consistency_only needs geom_consistency; ";
   }
+  if (geom_consistency_only && skip_existing) {
+    // The first pass's jobs wrote .geometric maps too (filtered against the maps there were
+    // then): existing ones cannot tell which views this pass did.
+    e << "geom_consistency_only estimates every view given again from the .photometric maps; "
+         "skip_existing would take the .geometric maps that the first pass wrote as done: run "
+         "it without skip_existing; ";
+  }
   if (visual_hull_mask_dilation_px < 0) e << "visual_hull_mask_dilation_px must be >= 0; ";
   if (visual_hull_min_carving_views < 1) e << "visual_hull_min_carving_views must be >= 1; ";
   if (num_levels < 1) e << "num_levels must be >= 1; ";
@@ -456,6 +463,20 @@ void WriteDepthAndNormals(const Workspace& workspace, const std::string& name,
   }
 }
 
+// Removes a view's `type` depth map (first: it marks the pair whole), normal map and their
+// pictures, where they exist.
+void RemoveDepthAndNormals(const Workspace& workspace, const std::string& name,
+                           const std::string& type) {
+  const std::string depth_path = workspace.DepthMapPath(name, type);
+  const std::string normal_path = workspace.NormalMapPath(name, type);
+  for (const std::string& path :
+       {depth_path, normal_path, depth_path + ".png", normal_path + ".png"}) {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+    THROW_IF(ec, "Cannot remove " << path << ": " << ec.message());
+  }
+}
+
 }  // namespace
 
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
@@ -675,6 +696,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     progress.Stage("writing");
     {
       ScopedStageTimer timer(timings, "writing");
+      // A .geometric map of an earlier run came from other .photometric maps than the one
+      // written now: kept, it would let a resumed run (skip_existing) take the view as done.
+      if (options.geom_consistency) RemoveDepthAndNormals(workspace, name, final_type);
       WriteDepthAndNormals(workspace, name, options.geom_consistency ? "photometric" : final_type,
                            view->estimate.depth, view->K, options.write_png);
       WriteMat(workspace.ConfidenceMapPath(name), view->estimate.confidence);

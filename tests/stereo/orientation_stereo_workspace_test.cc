@@ -413,6 +413,42 @@ TEST(OrientationStereoWorkspace, SkipExistingResumesWhereARunStopped) {
   std::filesystem::remove_all(path);
 }
 
+// A view estimated again loses its older .geometric map as its new .photometric one is written:
+// a run stopped before the geometric pass leaves the view to be resumed there, not skipped as
+// done with a .geometric map of other maps. And geom_consistency_only, which redoes the
+// .geometric maps that the first pass wrote, refuses skip_existing.
+TEST(OrientationStereoWorkspace, ANewFirstEstimateRemovesTheOlderGeometricMap) {
+  const std::string path = MakeTestDir("stereo_new_first_estimate");
+  WriteWorkspace(path);
+  OrientationStereoOptions options = PlaneOptions();
+  StageTimings timings;
+  ASSERT_EQ(RunOrientationStereo(path, {}, options, &timings).num_views, 4);
+  const Workspace workspace = Workspace::Read(path);
+  // The run stops right after v0's new .photometric pair: its confidence map cannot be written
+  // (a folder in the way).
+  const std::string confidence = workspace.ConfidenceMapPath("v0.png");
+  std::filesystem::remove(confidence);
+  CreateDirs(JoinPaths(confidence, "in_the_way"));
+  options.num_depths = 64;
+  EXPECT_NE(ErrorOf([&] { RunOrientationStereo(path, {"v0.png"}, options, &timings); })
+                .find(confidence),
+            std::string::npos);
+  EXPECT_TRUE(ExistsFile(workspace.DepthMapPath("v0.png", "photometric")));
+  EXPECT_FALSE(ExistsFile(workspace.DepthMapPath("v0.png", "geometric")));
+  EXPECT_FALSE(ExistsFile(workspace.NormalMapPath("v0.png", "geometric")));
+  std::filesystem::remove_all(confidence);
+  options.skip_existing = true;
+  const OrientationStereoResult resumed = RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_EQ(resumed.num_skipped, 3);
+  EXPECT_EQ(resumed.num_resumed_at_geometric_pass, 1);
+  EXPECT_TRUE(ExistsFile(workspace.DepthMapPath("v0.png", "geometric")));
+  options.geom_consistency_only = true;
+  EXPECT_NE(ErrorOf([&] { RunOrientationStereo(path, {}, options, &timings); })
+                .find("run it without skip_existing"),
+            std::string::npos);
+  std::filesystem::remove_all(path);
+}
+
 TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhotometricPixels) {
   const std::string path = MakeTestDir("stereo_consistency");
   const FloatMap true_depth = WriteWorkspace(path)[0];
