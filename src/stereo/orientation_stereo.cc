@@ -746,7 +746,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     // The views whose maps a view's prior and filter read: its sources and, within
     // geom_consistency_max_view_angle_deg, the other views of this run looking the same way
     // (of this run: so that a job of an array, given its own views, reads no map that another
-    // job may or may not have written yet). Views without sources of their own (a
+    // job may or may not have written yet; with geom_consistency_only, of the workspace, whose
+    // .photometric maps are all written by then, so that a job of that pass reads what one
+    // process would). Views without sources of their own (a
     // patch-match.cfg listing only some references) never have a map: they are matched
     // against, not read.
     std::map<std::string, std::vector<std::string>> consistency_views_of;
@@ -762,7 +764,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         std::vector<std::string>& views = consistency_views_of[name];
         for (std::string& other : ViewsLookingTheSameWay(
                  workspace, name, views, options.geom_consistency_max_view_angle_deg)) {
-          if (in_run.count(other) > 0 && sources_of.count(other) > 0) {
+          if ((options.geom_consistency_only || in_run.count(other) > 0) &&
+              sources_of.count(other) > 0) {
             views.push_back(std::move(other));
           }
         }

@@ -683,9 +683,17 @@ TEST(OrientationStereoWorkspace, GeometricPassAlsoReadsTheViewsLookingTheSameWay
   RunOrientationStereo(path, {}, options, &timings);
   EXPECT_GT(num_kept("v0.png"), 96 * 72 / 2);
   EXPECT_EQ(num_kept("v1.png"), v1_kept);  // its sources are all the others already
-  // Only the views of the run: v0 alone reads no other map than its source's.
+  // A job of the geometric pass alone, given v0 alone, reads the maps one process would: all
+  // .photometric maps exist by then.
+  const FloatMap whole_run = ReadMat(workspace.DepthMapPath("v0.png", "geometric"));
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), whole_run.Data());
+  // A job of both passes reads only its own views' maps (the others' may be being written):
+  // v0 alone reads no other map than its source's.
+  options.geom_consistency_only = false;
   RunOrientationStereo(path, {"v0.png"}, options, &timings);
   EXPECT_EQ(num_kept("v0.png"), 0);
+  options.geom_consistency_only = true;
   // Views beyond the angle are not read.
   options.geom_consistency_max_view_angle_deg = 10;
   RunOrientationStereo(path, {}, options, &timings);
