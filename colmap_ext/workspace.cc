@@ -119,12 +119,33 @@ FloatMap Workspace::RequireCameraSize(const std::string& name, FloatMap image) c
   return image;
 }
 
-FloatMap Workspace::ReadViewGray(const std::string& name) const {
-  return RequireCameraSize(name, ReadImageGray(ImagePath(name)));
+namespace {
+
+FloatMap ResizeArea(const FloatMap& input, int width, int height) {
+  if (input.Width() == width && input.Height() == height) return input;
+  FloatMap out(width, height, input.Channels());
+  for (int c = 0; c < input.Channels(); ++c) {
+    cv::Mat src(input.Height(), input.Width(), CV_32F, const_cast<float*>(input.Channel(c)));
+    cv::Mat dst(height, width, CV_32F, out.Channel(c));
+    cv::resize(src, dst, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  }
+  return out;
 }
 
-FloatMap Workspace::ReadViewRgb(const std::string& name) const {
-  return RequireCameraSize(name, ReadImageRgb(ImagePath(name)));
+}  // namespace
+
+FloatMap Workspace::ReadViewGray(const std::string& name, int max_image_size) const {
+  FloatMap image = RequireCameraSize(name, ReadImageGray(ImagePath(name)));
+  if (max_image_size <= 0) return image;
+  const StereoCamera camera = ViewCamera(name).AtMaxImageSize(max_image_size);
+  return ResizeArea(image, camera.width, camera.height);
+}
+
+FloatMap Workspace::ReadViewRgb(const std::string& name, int max_image_size) const {
+  FloatMap image = RequireCameraSize(name, ReadImageRgb(ImagePath(name)));
+  if (max_image_size <= 0) return image;
+  const StereoCamera camera = ViewCamera(name).AtMaxImageSize(max_image_size);
+  return ResizeArea(image, camera.width, camera.height);
 }
 
 std::string Workspace::ImagePath(const std::string& name) const {

@@ -43,9 +43,11 @@ class Workspace {
   std::string ImagePath(const std::string& name) const;
   // Image `name` in grey / RGB (ReadImageGray / ReadImageRgb of ImagePath). Throws unless it
   // has its camera's size: an image resized or cropped after image_undistorter no longer fits
-  // its intrinsics, which would put every depth off.
-  FloatMap ReadViewGray(const std::string& name) const;
-  FloatMap ReadViewRgb(const std::string& name) const;
+  // its intrinsics, which would put every depth off. With `max_image_size` (> 0), area-resized
+  // to the processing size ViewCamera(name).AtMaxImageSize(max_image_size), as COLMAP's
+  // stereo reads it.
+  FloatMap ReadViewGray(const std::string& name, int max_image_size = -1) const;
+  FloatMap ReadViewRgb(const std::string& name, int max_image_size = -1) const;
   // The camera of image `name` (its intrinsics and pose) on its image's pixel grid; Scaled()
   // carries it to a smaller map's (COLMAP's max_image_size, a coarse grid).
   StereoCamera ViewCamera(const std::string& name) const;

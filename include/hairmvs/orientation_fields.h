@@ -116,6 +116,10 @@ struct OrientationFieldsRunOptions {
   std::string mask_path;
   // --OpenCL.device (see src/opencl/opencl_options.h).
   std::string opencl_device;
+  // > 0: the images area-resized so that their larger side is at most this, as the stereo
+  // reads them with the same --OrientationStereo.max_image_size (which then reuses the fields
+  // written); -1: full size.
+  int max_image_size = -1;
   // An image whose fields in stereo/orientation_maps/ are up to date (their provenance holds:
   // the same image and mask bytes, size and filter options; with write_png, its pictures
   // there) is not computed again, as colmap feature_extractor skips the images it has

@@ -47,6 +47,9 @@ int RunOrientationFieldsCommand(int argc, char** argv) {
   parser.Add("mask_path", &run_options.mask_path,
              "masks folder (<image name>.png, 0 = excluded; default: <workspace>/masks if any)");
   parser.Add("write_png", &run_options.write_png, "also write <...>.l<k>.png pictures");
+  parser.Add("max_image_size", &run_options.max_image_size,
+             "larger image side at most this, as the stereo's same max_image_size reads them "
+             "(-1: full size)");
   parser.Add("skip_up_to_date", &run_options.skip_up_to_date,
              "keep the images whose cached fields' provenance holds (0: compute all again)");
   parser.Add("timing", &timing, "print the per-stage timing table and the peak memory");

@@ -144,8 +144,13 @@ int RunPipeline(int argc, char** argv) {
     run_options.mask_path = stereo_options.mask_path;
     run_options.write_png = write_png;
     run_options.opencl_device = opencl_options.device;
+    // The fields the stereo stage reads: at its size and with its levels, so that it reuses
+    // them (and their pictures) rather than computing them again.
+    run_options.max_image_size = stereo_options.max_image_size;
+    OrientationFieldOptions fields = orientation_options;
+    fields.num_levels = stereo_options.PyramidLevels();
     const OrientationFieldsResult result =
-        RunOrientationFields(workspace_path, orientation_options, run_options, &timings);
+        RunOrientationFields(workspace_path, fields, run_options, &timings);
     std::printf("%s\n", result.BriefReport().c_str());
   }
   if (HasStage(stages, "stereo")) {

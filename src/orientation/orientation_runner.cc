@@ -71,6 +71,8 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   Timer total_timer;
   std::string error;
   THROW_IF(!options.Check(&error), "OrientationField options: " << error);
+  THROW_IF(run_options.max_image_size == 0 || run_options.max_image_size < -1,
+           "invalid --max_image_size " << run_options.max_image_size << ": must be > 0 or -1");
   Workspace workspace = [&] {
     ScopedStageTimer timer(timings, "read workspace");
     return Workspace::Read(workspace_path, run_options.mask_path);
@@ -97,7 +99,8 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   for (size_t i = 0; i < names.size(); ++i) {
     const std::string& name = names[i];
     progress.Start(static_cast<int>(i), name);
-    const StereoCamera camera = workspace.ViewCamera(name);
+    const StereoCamera camera =
+        workspace.ViewCamera(name).AtMaxImageSize(run_options.max_image_size);
     const std::string provenance =
         OrientationFieldsProvenance(workspace, name, camera.width, camera.height, options);
     // The cached levels, read and checked against the bytes their provenance recorded, as the
@@ -129,7 +132,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
       FloatMap gray, mask;
       {
         ScopedStageTimer timer(timings, "read image");
-        gray = workspace.ReadViewGray(name);
+        gray = workspace.ReadViewGray(name, run_options.max_image_size);
         const std::string mask_path = workspace.MaskPath(name);
         if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
       }

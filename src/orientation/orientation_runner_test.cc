@@ -145,6 +145,36 @@ TEST(RunOrientationFields, ImageSubsetAndErrors) {
   std::system(("rm -rf " + root).c_str());
 }
 
+// With max_image_size the fields are those the stereo reads at the same size (the image
+// area-resized): its cache check holds for them, and a second run keeps them.
+TEST(RunOrientationFields, AtTheStereosMaxImageSize) {
+  const std::string root = MakeWorkspace();
+  OrientationFieldsRunOptions run_options;
+  run_options.max_image_size = kWidth / 2;
+  const OrientationFieldOptions options;
+  EXPECT_EQ(RunOrientationFields(root, options, run_options, nullptr).num_images, 2);
+  const Workspace workspace = Workspace::Read(root);
+  const StereoCamera camera = workspace.ViewCamera("b.png").AtMaxImageSize(kWidth / 2);
+  ASSERT_EQ(camera.width, kWidth / 2);
+  const FloatMap level0 = ReadMat(workspace.OrientationMapPath("b.png", 0));
+  EXPECT_EQ(level0.Width(), kWidth / 2);
+  EXPECT_EQ(level0.Height(), kHeight / 2);
+  const std::string provenance =
+      OrientationFieldsProvenance(workspace, "b.png", camera.width, camera.height, options);
+  std::string why_not;
+  EXPECT_TRUE(ReadCachedOrientationFields(workspace, "b.png", provenance, camera,
+                                          options.num_levels, &why_not))
+      << why_not;
+  EXPECT_EQ(RunOrientationFields(root, options, run_options, nullptr).num_up_to_date, 2);
+  // At full size they are computed again.
+  run_options.max_image_size = -1;
+  EXPECT_EQ(RunOrientationFields(root, options, run_options, nullptr).num_images, 2);
+  EXPECT_EQ(ReadMat(workspace.OrientationMapPath("b.png", 0)).Width(), kWidth);
+  run_options.max_image_size = 0;
+  EXPECT_THROW(RunOrientationFields(root, options, run_options, nullptr), Error);
+  std::system(("rm -rf " + root).c_str());
+}
+
 // The cached fields are reused while the image, the mask, the size and the filter options they
 // were computed from still hold, and only then; each miss says why.
 TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {

@@ -240,17 +240,6 @@ std::string OrientationStereoResult::BriefReport() const {
 
 namespace {
 
-FloatMap ResizeArea(const FloatMap& input, int width, int height) {
-  if (input.Width() == width && input.Height() == height) return input;
-  FloatMap out(width, height, input.Channels());
-  for (int c = 0; c < input.Channels(); ++c) {
-    cv::Mat src(input.Height(), input.Width(), CV_32F, const_cast<float*>(input.Channel(c)));
-    cv::Mat dst(height, width, CV_32F, out.Channel(c));
-    cv::resize(src, dst, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  }
-  return out;
-}
-
 void WriteDepthPng(const std::string& path, const FloatMap& depth) {
   std::vector<float> valid;
   for (float d : depth.Data()) {
@@ -377,7 +366,7 @@ class ViewLoader {
     if (cached) {
       data.orientation = std::move(*cached);
     } else {
-      const FloatMap gray = ResizeArea(workspace_.ReadViewGray(name), w, h);
+      const FloatMap gray = workspace_.ReadViewGray(name, options_.max_image_size);
       const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
         computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
@@ -395,7 +384,7 @@ class ViewLoader {
       }
     }
     if (options_.MatchesColour()) {
-      data.rgb.push_back(ResizeArea(workspace_.ReadViewRgb(name), w, h));
+      data.rgb.push_back(workspace_.ReadViewRgb(name, options_.max_image_size));
       for (int l = 1; l < options_.PyramidLevels(); ++l) {
         data.rgb.push_back(DownsampleHalf(data.rgb.back()));
       }
