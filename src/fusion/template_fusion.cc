@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <sstream>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/ply.h"
+#include "colmap_ext/source_views.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
@@ -196,11 +198,27 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
     ScopedStageTimer timer(timings, "read depth maps");
     const Workspace workspace = Workspace::Read(workspace_path);
     const std::vector<std::string>& names = workspace.ImageNames();
+    // As colmap stereo_fusion: stereo/fusion.cfg, where it exists, says which views are fused
+    // (their index in .vis stays the model's).
+    std::set<std::string> listed(names.begin(), names.end());
+    const std::string fusion_cfg = JoinPaths(workspace_path, "stereo", "fusion.cfg");
+    if (ExistsFile(fusion_cfg)) {
+      const std::vector<std::string> cfg_names = ReadFusionConfig(fusion_cfg, workspace.Model());
+      listed = std::set<std::string>(cfg_names.begin(), cfg_names.end());
+      if (listed.size() < names.size()) {
+        LOG(INFO) << fusion_cfg << " lists " << listed.size() << " of the " << names.size()
+                  << " views: only those are fused";
+      }
+    }
     Progress progress("template_fusion read", static_cast<int>(names.size()));
     std::vector<std::string> photometric_only;  // --input_type auto took their first estimate
     for (size_t idx = 0; idx < names.size(); ++idx) {
       const std::string& name = names[idx];
       progress.Start(static_cast<int>(idx), name);
+      if (listed.count(name) == 0) {
+        progress.Stage("not in stereo/fusion.cfg, skipped");
+        continue;
+      }
       std::string type = options.input_type;
       if (type == "auto") {
         type = ExistsFile(workspace.DepthMapPath(name, "geometric")) ? "geometric" : "photometric";

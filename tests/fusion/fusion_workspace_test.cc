@@ -156,6 +156,40 @@ TEST(FusionWorkspace, WritesFusedPlyAndMeshThatColmapReads) {
   std::filesystem::remove_all(dir);
 }
 
+// stereo/fusion.cfg, where it exists, says which views are fused, as for colmap stereo_fusion;
+// their .vis indices stay the model's.
+TEST(FusionWorkspace, FusionCfgSaysWhichViewsAreFused) {
+  const std::string dir = MakeTestDir("fusion_cfg");
+  const std::vector<FusionView> views =
+      testing::RenderViews(testing::TorusSdf(1.0, 0.4), TorusViews());
+  const int n = static_cast<int>(views.size());
+  ASSERT_GE(n, 3);
+  WriteWorkspace(views, dir);
+  const std::string cfg = JoinPaths(dir, "stereo", "fusion.cfg");
+  WriteFileAtomically(cfg, [&](std::ostream& out) {
+    out << views[0].name << "\n" << views[1].name << "\n";
+  });
+  StageTimings timings;
+  const TemplateFusionResult result = RunTemplateFusion(dir, EveryPixelOneThread(), &timings);
+  EXPECT_EQ(result.num_views, 2);
+  const std::vector<FusedPoint> points = ReadFusedPly(result.fused_path);
+  ASSERT_FALSE(points.empty());
+  for (const FusedPoint& p : points) {
+    for (uint32_t idx : p.visible_image_idxs) {
+      // Ids were reversed: view i is image_idx n-1-i.
+      ASSERT_TRUE(idx == static_cast<uint32_t>(n - 1) || idx == static_cast<uint32_t>(n - 2))
+          << idx;
+    }
+  }
+  // A name that is no image of the model is named with the file.
+  WriteFileAtomically(cfg, [&](std::ostream& out) { out << "nowhere.png\n"; });
+  const std::string message =
+      testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), &timings); });
+  EXPECT_NE(message.find(cfg), std::string::npos) << message;
+  EXPECT_NE(message.find("nowhere.png"), std::string::npos) << message;
+  std::filesystem::remove_all(dir);
+}
+
 // Depth maps without normal maps (another tool's, or normal maps deleted to save space):
 // the normals of the fused points come from the depth maps, and the log says so per view.
 TEST(FusionWorkspace, NormalsFromTheDepthMapsWhereNormalMapsAreMissing) {
