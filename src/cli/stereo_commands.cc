@@ -1,6 +1,7 @@
 // hairmvs orientation_stereo: orientation-field depth maps of a COLMAP dense workspace.
 // hairmvs patch_match_stereo: the same, behind colmap patch_match_stereo's command line.
 
+#include <cctype>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -127,16 +128,20 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
                     "--OrientationStereo.geom_prior_weight");
   parser.AddIgnored("PatchMatchStereo.gpu_index", "use --OpenCL.device to pick the device");
   parser.AddIgnored("PatchMatchStereo.cache_size", "views are cached by count, not size");
-  parser.AddIgnored("PatchMatchStereo.allow_missing_files", "missing files are errors here");
+  parser.AddIgnored("PatchMatchStereo.allow_missing_files",
+                    "a view whose sources have no maps yet gets an unfiltered .geometric map, "
+                    "with a warning");
   parser.AddIgnored("pmvs_option_name", "only --workspace_format COLMAP is supported");
   // The options colmap gives every command.
-  parser.AddIgnored("project_path",
-                    "colmap's project .ini files are not read: give the options here");
+  parser.AddProjectPath({"PatchMatchStereo"});
   parser.AddIgnored("random_seed", "the orientation stereo draws no random numbers");
   parser.AddIgnored("log_to_stderr", "hairmvs logs to stderr always");
   parser.AddIgnored("log_level", "hairmvs logs warnings and errors always");
   if (!parser.Parse(argc, argv)) return 0;
-  THROW_IF(workspace_format != "COLMAP",
+  // Any case, as colmap takes it.
+  std::string format = workspace_format;
+  for (char& c : format) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  THROW_IF(format != "COLMAP",
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
   if (parser.WasGiven("config_path")) source_options.config_path = config_path;
   // colmap's options and the fields they set: applied where given, and named in the error

@@ -1,6 +1,7 @@
 #include "src/core/option_parser.h"
 
 #include <boost/program_options.hpp>
+#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -31,6 +32,8 @@ struct OptionParser::Impl {
   // "nan", which no option means and which pass many a range check (nan fails every
   // comparison, inf passes every lower bound).
   std::map<std::string, std::function<bool()>> finite_checks;
+  // AddProjectPath's sections; empty without it.
+  std::vector<std::string> project_sections;
 };
 
 OptionParser::OptionParser(std::string command, std::string description)
@@ -95,7 +98,10 @@ void OptionParser::Add(const std::string& name, bool* value, const std::string& 
                        bool required) {
   AddConverted(
       name, *value ? "1" : "0", help, required,
-      [value](const std::string& text) {
+      [value](const std::string& given) {
+        // Any case, as colmap's parser takes them ("True", "YES").
+        std::string text = given;
+        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
         if (text == "1" || text == "true" || text == "on" || text == "yes") *value = true;
         else if (text == "0" || text == "false" || text == "off" || text == "no") *value = false;
         else return false;
@@ -138,6 +144,24 @@ void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
   impl_->ignored[name] = why;
 }
 
+void OptionParser::AddProjectPath(const std::vector<std::string>& sections) {
+  impl_->desc.add_options()("project_path", po::value<std::string>(),
+                            "colmap project .ini file of options (those given here win)");
+  impl_->project_sections = sections;
+}
+
+namespace {
+
+// Whether `key` ("Section.name") belongs to one of `sections`.
+bool InSections(const std::string& key, const std::vector<std::string>& sections) {
+  for (const std::string& section : sections) {
+    if (key.rfind(section + ".", 0) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 bool OptionParser::Parse(int argc, char** argv, int first) {
   std::vector<std::string> args(argv + first, argv + argc);
   try {
@@ -160,6 +184,41 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
     if (impl_->vm.count("help")) {
       std::cout << Help();
       return false;
+    }
+    if (!impl_->project_sections.empty() && impl_->vm.count("project_path")) {
+      // Stored after the command line: boost keeps the first value stored of an option.
+      const std::string path = impl_->vm["project_path"].as<std::string>();
+      RequireFile(path, "project file (--project_path)");
+      std::istringstream in(ReadTextFile(path));
+      po::parsed_options from_file(nullptr);
+      try {
+        from_file = po::parse_config_file(in, impl_->desc, /*allow_unregistered=*/true);
+      } catch (const po::error& e) {
+        HAIRMVS_THROW("--project_path " << path << ": " << e.what());
+      }
+      // The file's options that take effect, and those of our sections without effect (named
+      // once here, rather than warned about one by one: a generated file lists them all).
+      std::vector<std::string> used, not_used;
+      for (const po::option& option : from_file.options) {
+        const std::string& key = option.string_key;
+        // Given on the command line: that value wins.
+        if (impl_->vm.count(key) && !impl_->vm[key].defaulted()) continue;
+        const bool in_sections = InSections(key, impl_->project_sections);
+        if (!option.unregistered && impl_->ignored.count(key) == 0) {
+          used.push_back(key + "=" + (option.value.empty() ? "" : option.value.front()));
+        } else if (in_sections) {
+          not_used.push_back(key);
+          impl_->ignored.erase(key);
+        }
+      }
+      po::store(from_file, impl_->vm);
+      LOG(INFO) << path << ": options taken from it: "
+                << (used.empty() ? "none" : JoinStrings(used, ", "));
+      if (!not_used.empty()) {
+        LOG(WARNING) << path << ": " << not_used.size() << " of its options have no effect "
+                     << "in hairmvs (see hairmvs " << impl_->command
+                     << " -h for why): " << JoinStrings(not_used, ", ");
+      }
     }
     po::notify(impl_->vm);
   } catch (const po::error& e) {

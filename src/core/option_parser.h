@@ -61,6 +61,13 @@ class OptionParser {
   // without effect here: if given, a warning says it is ignored and why.
   void AddIgnored(const std::string& name, const std::string& why);
 
+  // `--project_path FILE`, as every colmap command takes it: an .ini file of options
+  // (`key=value` at the top, `[Section]` then `key=value` for `--Section.key`), as colmap
+  // project_generator and colmap's GUI write it. Options given on the command line win over
+  // the file's; the file's sections for other commands are passed over, and its options of
+  // `sections` that are ignored here or unknown are named in one warning. A missing or
+  // malformed file is an error naming it.
+  void AddProjectPath(const std::vector<std::string>& sections);
   // Parses argv[first..argc). Returns false when help was requested (and printed).
   // Throws hairmvs::Error on an unknown option, a missing value or a bad value.
   bool Parse(int argc, char** argv, int first = 2);

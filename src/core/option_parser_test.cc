@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
 #include "src/core/enum_names.h"
+#include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/test_util.h"
 
@@ -67,6 +70,62 @@ TEST(OptionParser, ParsesSectionsInColmapStyle) {
   EXPECT_TRUE(parser.WasGiven("Toy.lambda"));
   EXPECT_FALSE(parser.WasGiven("Toy.num_levels"));
   EXPECT_NE(parser.Values().find("Toy.solver = semi_global"), std::string::npos);
+}
+
+// colmap's --project_path: the .ini's options apply where the command line gives none; its
+// sections of other commands are passed over; its options of our sections that have no effect
+// are named in one warning. Booleans take any case, as colmap's do.
+TEST(OptionParser, ProjectFileAsColmapsWithTheCommandLineWinning) {
+  const std::string dir = testing_util::MakeTestDir("project_path");
+  const std::string ini = JoinPaths(dir, "project.ini");
+  WriteFileAtomically(ini, [](std::ostream& out) {
+    out << "log_to_stderr=true\nworkspace_path=/from/ini\n[SiftExtraction]\nmax_num_features="
+           "8192\n[Toy]\nlambda=0.75\nnum_levels=5\nwrite_png=True\nwindow_radius=5\n"
+           "gpu_index=-1\n";
+  });
+  ToyOptions options;
+  std::string workspace;
+  OptionParser parser("toy", "a toy command");
+  parser.Add("workspace_path", &workspace, "workspace", /*required=*/true);
+  parser.AddSection("Toy", &options);
+  parser.AddIgnored("Toy.gpu_index", "no such thing here");
+  parser.AddProjectPath({"Toy"});
+  std::vector<std::string> args = {"hairmvs", "toy", "--project_path", ini, "--Toy.num_levels",
+                                   "2"};
+  auto argv = Argv(args);
+  ::testing::internal::CaptureStderr();
+  ASSERT_TRUE(parser.Parse(static_cast<int>(argv.size()), argv.data()));
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(workspace, "/from/ini");  // a required option, given by the file
+  EXPECT_DOUBLE_EQ(options.lambda, 0.75);
+  EXPECT_EQ(options.num_levels, 2);  // the command line's
+  EXPECT_TRUE(options.write_png);
+  EXPECT_TRUE(parser.WasGiven("Toy.lambda"));
+  EXPECT_NE(log.find("2 of its options have no effect"), std::string::npos) << log;
+  EXPECT_NE(log.find("Toy.window_radius, Toy.gpu_index"), std::string::npos) << log;
+  EXPECT_NE(log.find("options taken from it: workspace_path=/from/ini, Toy.lambda=0.75, "
+                     "Toy.write_png=True\n"),
+            std::string::npos)
+      << log;
+  EXPECT_EQ(log.find("max_num_features"), std::string::npos) << log;
+  EXPECT_EQ(log.find("--Toy.gpu_index is ignored"), std::string::npos) << log;
+
+  // A missing file and a malformed one are named.
+  for (const auto& [text, why] : std::vector<std::pair<std::string, std::string>>{
+           {"", "Missing project file"}, {"[Toy\nlambda=1\n", "project.ini"}}) {
+    if (text.empty()) {
+      std::filesystem::remove(ini);
+    } else {
+      WriteFileAtomically(ini, [&](std::ostream& out) { out << text; });
+    }
+    OptionParser again("toy", "a toy command");
+    again.AddSection("Toy", &options);
+    again.AddProjectPath({"Toy"});
+    const std::string message =
+        testing_util::ErrorOf([&] { again.Parse(static_cast<int>(argv.size()), argv.data()); });
+    EXPECT_NE(message.find(why), std::string::npos) << message;
+    EXPECT_NE(message.find(ini), std::string::npos) << message;
+  }
 }
 
 TEST(OptionParser, RejectsUnknownOptionsAndBadValues) {
