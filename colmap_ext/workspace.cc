@@ -5,12 +5,16 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <filesystem>
 #include <sstream>
 
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+
+namespace fs = std::filesystem;
 
 namespace hairmvs {
 
@@ -43,6 +47,26 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
     ws.mask_path_ = JoinPaths(path, "masks");
   }
   const std::vector<std::string> unmasked = ws.ImagesWithoutMask();
+  if (!unmasked.empty() && unmasked.size() == ws.image_names_.size()) {
+    // Files there, but none named for an image: a naming mistake (the image's stem, say), not
+    // a choice to match the whole scene.
+    std::error_code ec;
+    for (const auto& entry : fs::directory_iterator(ws.mask_path_, ec)) {
+      std::string extension = entry.path().extension().string();
+      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      if (!entry.is_regular_file(ec) || entry.path().filename().string()[0] == '.' ||
+          (extension != ".png" && extension != ".jpg" && extension != ".jpeg" &&
+           extension != ".bmp" && extension != ".tif" && extension != ".tiff")) {
+        continue;
+      }
+      HAIRMVS_THROW("No mask in " << ws.mask_path_ << " belongs to an image of the workspace: "
+                                  << "it holds " << entry.path().filename().string()
+                                  << ", but the mask of the image " << ws.image_names_.front()
+                                  << " is " << JoinPaths(ws.mask_path_,
+                                                         ws.image_names_.front() + ".png")
+                                  << " (COLMAP's naming: <image name>.png)");
+    }
+  }
   if (!unmasked.empty()) {
     // COLMAP skips a missing mask silently; here a view without one lets its background into
     // the depth range and the depth map, so say which.
@@ -350,6 +374,21 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     cv::Mat nonzero = channels[c] != 0;
     cv::bitwise_or(keep, nonzero, keep);
   }
+  if (num_colour < static_cast<int>(channels.size())) {
+    // A cut-out (a background-removal tool's PNG: the photo in colour, the mask as alpha)
+    // would keep everything by its colour, as COLMAP reads it; its alpha says otherwise. Where
+    // the two disagree beyond an antialiased rim, the file's meaning is not COLMAP's: refused.
+    const cv::Mat alpha_keeps = channels.back() != 0;
+    cv::Mat disagree;
+    cv::bitwise_xor(keep, alpha_keeps, disagree);
+    const double fraction = static_cast<double>(cv::countNonZero(disagree)) / keep.total();
+    THROW_IF(fraction > 0.01,
+             "Mask " << path << ": its alpha channel and its colour disagree on "
+                     << std::lround(100 * fraction) << "% of the pixels; COLMAP reads a mask "
+                     << "as a grey image (0 = excluded) and ignores alpha: write it as a grey "
+                        "PNG, 0 where excluded and 255 where kept (e.g. the alpha channel "
+                        "alone)");
+  }
   const int num_kept = cv::countNonZero(keep);
   THROW_IF(num_kept == 0, "Mask " << path << " excludes every pixel (all zero at " << keep.cols
                                   << "x" << keep.rows << ")");
@@ -361,7 +400,12 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
     THROW_IF(!IsScaledCopy(keep.cols, keep.rows, width, height),
              "Mask " << path << " is " << keep.cols << " x " << keep.rows
                      << ", another aspect ratio than its image's (read at " << width << " x "
-                     << height << "): a mask is drawn on its own image (the workspace's "
+                     << height << ")"
+                     << (IsScaledCopy(keep.rows, keep.cols, width, height)
+                             ? ", its width and height swapped (turned by an EXIF orientation "
+                               "that an editor applied? COLMAP ignores the tag)"
+                             : "")
+                     << ": a mask is drawn on its own image (the workspace's "
                         "images/ as colmap image_undistorter wrote them, or the photo for "
                         "undistort_masks), or is a scaled copy of one");
     cv::Mat resized;

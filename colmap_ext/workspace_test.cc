@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
 #include "colmap_ext/test_util.h"
@@ -71,6 +72,18 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_EQ(ws2.ImagesWithoutMask(), (std::vector<std::string>{"b.png", "c.png"}));
   EXPECT_NE(ErrorOf([&] { Workspace::Read(dir, JoinPaths(dir, "nomasks")); }).find("nomasks"),
             std::string::npos);
+  // Masks named for no image (the image's stem, the usual slip): an error with COLMAP's naming,
+  // not a run without masks. Other files do not count; a folder without images is a warning.
+  const std::string stems = JoinPaths(dir, "stem_masks");
+  std::filesystem::create_directories(stems);
+  std::ofstream(JoinPaths(stems, "notes.txt")) << "drawn by hand";
+  EXPECT_EQ(Workspace::Read(dir, stems).ImagesWithoutMask().size(), 3u);
+  cv::imwrite(JoinPaths(stems, "a.jpg"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
+  const std::string stem_error = ErrorOf([&] { Workspace::Read(dir, stems); });
+  EXPECT_NE(stem_error.find("No mask in " + stems + " belongs to an image"), std::string::npos)
+      << stem_error;
+  EXPECT_NE(stem_error.find("holds a.jpg"), std::string::npos) << stem_error;
+  EXPECT_NE(stem_error.find(JoinPaths(stems, "a.png.png")), std::string::npos) << stem_error;
 }
 
 TEST(Workspace, BadWorkspaces) {
@@ -269,6 +282,28 @@ TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
   EXPECT_NE(error.find("wide.png is 960 x 640"), std::string::npos) << error;
   EXPECT_NE(error.find("600 x 450"), std::string::npos) << error;
   EXPECT_NE(ErrorOf([&] { ReadMask(wide, 160, 110); }).find("aspect ratio"), std::string::npos);
+  // Width and height swapped (an editor that applied an EXIF orientation): said so.
+  EXPECT_NE(ErrorOf([&] { ReadMask(wide, 640, 960); }).find("its width and height swapped"),
+            std::string::npos);
+  EXPECT_EQ(ErrorOf([&] { ReadMask(wide, 600, 450); }).find("swapped"), std::string::npos);
+
+  // Alpha: a white-on-transparent mask (colour and alpha agree) is read by its colour; a cut-out
+  // (the photo in colour, the mask in alpha) is refused, where COLMAP would keep every pixel.
+  cv::Mat agree(8, 8, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+  agree(cv::Rect(0, 0, 4, 8)).setTo(cv::Scalar(255, 255, 255, 255));
+  const std::string agree_path = JoinPaths(dir, "agree.png");
+  ASSERT_TRUE(cv::imwrite(agree_path, agree));
+  const FloatMap agreed = ReadMask(agree_path, 8, 8);
+  EXPECT_EQ(agreed.At(0, 0), 1.0f);
+  EXPECT_EQ(agreed.At(0, 7), 0.0f);
+  cv::Mat cut_out(8, 8, CV_8UC4, cv::Scalar(90, 120, 200, 0));
+  cut_out(cv::Rect(0, 0, 4, 8)).setTo(cv::Scalar(90, 120, 200, 255));
+  const std::string cut_out_path = JoinPaths(dir, "cut_out.png");
+  ASSERT_TRUE(cv::imwrite(cut_out_path, cut_out));
+  const std::string alpha_error = ErrorOf([&] { ReadMask(cut_out_path, 8, 8); });
+  EXPECT_NE(alpha_error.find("cut_out.png: its alpha channel and its colour disagree on 50%"),
+            std::string::npos)
+      << alpha_error;
 }
 
 }  // namespace

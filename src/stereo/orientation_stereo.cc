@@ -525,6 +525,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     RequireWritableDir(ParentPath(workspace.DepthMapPath(name)), "depth map folder");
     RequireWritableDir(ParentPath(workspace.NormalMapPath(name)), "normal map folder");
     RequireWritableDir(ParentPath(workspace.ConfidenceMapPath(name)), "confidence map folder");
+    if (options.write_cost_volume) {
+      RequireWritableDir(ParentPath(workspace.CostVolumePath(name)), "cost volume folder");
+    }
   }
   ViewLoader loader(workspace, options, fields, context, timings);
   OrientationStereoResult result;
@@ -659,12 +662,16 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         context.get(), ref, sources, mask, search.visual_hull_entry, labels, options, timings,
         progress, prior, cache != nullptr ? &cache->coarse_volume : nullptr);
 
+    // The prior's maps: the sources' and those of the views looking the same way.
+    const std::string prior_maps =
+        prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
+                         : "";
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "
                 "MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
                 depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
-                prior != nullptr ? " and their depth maps" : "", estimate.num_valid,
-                estimate.coarse_energy, estimate.fine_energy);
+                prior_maps.c_str(), estimate.num_valid, estimate.coarse_energy,
+                estimate.fine_energy);
     std::fflush(stdout);
     return ViewEstimate{std::move(estimate), ref.camera.K};
   };
