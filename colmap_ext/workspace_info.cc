@@ -46,6 +46,13 @@ WorkspaceInfo ComputeWorkspaceInfo(const std::string& workspace_path,
     for (const Point2D& p : image.points2D) {
       row.num_points3D += p.point3D_id != kInvalidPoint3DId && model.points3D.count(p.point3D_id);
     }
+    // Read as the stereo reads it (decoded whole: a file cut short or of another size than its
+    // camera is found here, not minutes into a run).
+    try {
+      ws.ReadViewGray(name);
+    } catch (const Error& e) {
+      row.image_error = e.what();
+    }
     row.mask_path = ws.MaskPath(name);
     if (!row.mask_path.empty()) {
       const Camera& camera = model.cameras.at(image.camera_id);
@@ -81,6 +88,7 @@ std::string WorkspaceInfo::Report() const {
   for (const WorkspaceInfoViewRow& v : views) {
     out << "  " << std::setw(3) << v.image_idx << " " << v.name << " id " << v.image_id
         << " cam " << v.camera_id << " " << v.num_points2D << "/" << v.num_points3D << " ";
+    if (!v.image_error.empty()) out << "image UNUSABLE ";
     if (v.mask_path.empty()) {
       out << "no-mask";
     } else if (!v.mask_error.empty()) {
@@ -100,6 +108,7 @@ std::string WorkspaceInfo::Report() const {
     out << std::setprecision(6) << "\n";
   }
   for (const WorkspaceInfoViewRow& v : views) {
+    if (!v.image_error.empty()) out << "Unusable image: " << v.image_error << "\n";
     if (!v.mask_error.empty()) out << "Unusable mask: " << v.mask_error << "\n";
   }
   out << "Source views (" << selections.size() << " references, " << num_t_groups

@@ -48,6 +48,13 @@ TEST(WorkspaceInfo, SyntheticWorkspace) {
   for (const char* part : {"mask UNUSABLE", "Unusable mask: Mask ", "c.png.png is 64 x 20"}) {
     EXPECT_NE(bad_report.find(part), std::string::npos) << part << "\n" << bad_report;
   }
+  // So are images of another size than their camera's (resized after the undistorter).
+  EXPECT_TRUE(bad.views[3].image_error.empty()) << bad.views[3].image_error;
+  ASSERT_TRUE(cv::imwrite(JoinPaths(dir, "images", "d.png"), cv::Mat(24, 32, CV_8U, 128.0)));
+  const std::string resized_report = ComputeWorkspaceInfo(dir, "", SourceViewOptions()).Report();
+  for (const char* part : {"image UNUSABLE", "Unusable image: Image ", "d.png is 32 x 24"}) {
+    EXPECT_NE(resized_report.find(part), std::string::npos) << part << "\n" << resized_report;
+  }
 }
 
 TEST(WorkspaceInfo, SharedGantrySetHasEightTGroups) {

@@ -55,7 +55,8 @@ int RunWorkspaceInfo(int argc, char** argv) {
   OptionParser parser("workspace_info",
                       "Lists the views, cameras, masks, source views (and why) and depth ranges "
                       "of a COLMAP dense workspace, and what of each view is computed already "
-                      "(orientation fields up to date or stale, depth maps).");
+                      "(orientation fields up to date or stale, depth maps). Reads every image "
+                      "and mask, and names those the stereo could not use.");
   parser.Add("workspace_path", &workspace_path, "COLMAP dense workspace (image_undistorter)",
              true);
   parser.Add("mask_path", &mask_path,
