@@ -170,6 +170,12 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   for (const MappedOption& option : mapped) {
     if (parser.WasGiven(option.colmap_name)) option.apply();
   }
+  if ((depth_min > 0) != (depth_max > 0)) {
+    // A script written for colmap may rely on its rule; the bound given is not dropped here.
+    LOG(WARNING) << "one depth bound given (--PatchMatchStereo.depth_min " << depth_min
+                 << ", depth_max " << depth_max << "): colmap would compute both from the "
+                 << "sparse points; hairmvs keeps the one given and computes the other";
+  }
   // As colmap's: without its geometric pass the maps are named .photometric.
   if (!parser.WasGiven("OrientationStereo.single_pass_type")) {
     options.single_pass_type = options.geom_consistency ? "geometric" : "photometric";
