@@ -87,10 +87,6 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
     computer = std::make_unique<OrientationFieldComputer>(context, options);
   }
   computer->SetTimings(timings);
-  // Created once the device holds, so that a run refused for it leaves no empty folders.
-  for (const auto& name : names) {
-    RequireWritableDir(ParentPath(workspace.OrientationMapPath(name, 0)), "orientation map folder");
-  }
 
   OrientationFieldsResult result;
   result.num_levels = options.num_levels;
@@ -122,6 +118,10 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
       }
       if (!why_not.empty()) progress.Stage(why_not + ": computing them again");
     }
+    // Checked (and created) only for a view that writes, before its work: fields all up to date
+    // in a folder this user may not write to (a shared, read-only workspace) are no error; and
+    // only once the device holds, so that a run refused for it leaves no empty folders.
+    RequireWritableDir(ParentPath(workspace.OrientationMapPath(name, 0)), "orientation map folder");
     std::vector<FloatMap> levels;
     if (cached) {
       // Only the pictures are missing: drawn from the fields read, not from the filter bank's
