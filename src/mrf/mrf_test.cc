@@ -51,6 +51,50 @@ double BruteForceMinimum(const MrfProblem& problem) {
   return best;
 }
 
+// The exact minimum of a chain (one row or one column) by dynamic programming over its labels,
+// independent of every solver.
+double ChainMinimum(const MrfProblem& problem) {
+  CHECK(problem.width == 1 || problem.height == 1);
+  const std::vector<float>& weights = problem.height == 1 ? problem.weight_right
+                                                          : problem.weight_down;
+  std::vector<double> best(problem.num_labels);  // of the chain up to p, p's label given
+  for (int l = 0; l < problem.num_labels; ++l) best[l] = problem.Cost(l, 0);
+  for (size_t p = 1; p < problem.NumPixels(); ++p) {
+    const float w = weights.empty() ? 0.0f : weights[p - 1];
+    std::vector<double> next(problem.num_labels);
+    for (int l = 0; l < problem.num_labels; ++l) {
+      double lowest = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < problem.num_labels; ++k) {
+        lowest = std::min(lowest, best[k] + MrfPairwise(problem, w, problem.Value(p - 1, k),
+                                                        problem.Value(p, l)));
+      }
+      next[l] = problem.Cost(l, p) + lowest;
+    }
+    best = next;
+  }
+  return *std::min_element(best.begin(), best.end());
+}
+
+// Whether no single pixel's label can be changed to lower the energy (ICM's fixed point).
+bool IsSingleSiteMinimum(const MrfProblem& problem, std::vector<int> labels, std::string* where) {
+  const double energy = MrfEnergy(problem, labels);
+  for (size_t p = 0; p < problem.NumPixels(); ++p) {
+    const int own = labels[p];
+    for (int l = 0; l < problem.num_labels; ++l) {
+      labels[p] = l;
+      const double moved = MrfEnergy(problem, labels);
+      if (moved < energy - 1e-6 * std::max(1.0, std::abs(energy))) {
+        *where = "pixel " + std::to_string(p) + ": label " + std::to_string(own) + " -> " +
+                 std::to_string(l) + " lowers " + std::to_string(energy) + " to " +
+                 std::to_string(moved);
+        return false;
+      }
+    }
+    labels[p] = own;
+  }
+  return true;
+}
+
 MrfResult Solve(const MrfProblem& problem, MrfSolverType type, OpenCLContext* context = nullptr,
                 int num_directions = 8, int icm_polish_iterations = 0) {
   MrfSolverOptions options;
@@ -332,6 +376,58 @@ TEST(SemiGlobal, PathMinimumEqualsBruteForce) {
 
 // The OpenCL belief propagation (with and without the ICM polish on the device) equals its
 // CPU reference.
+// Independent of the kernels' CPU copies: on a chain (a tree), min-sum belief propagation is
+// exact, so the device's labels reach the dynamic programme's minimum; rows and columns, with
+// label offsets and truncation.
+TEST(BeliefPropagation, ExactOnAChain) {
+  for (const auto& [width, height] : {std::pair<int, int>{14, 1}, std::pair<int, int>{1, 14}}) {
+    for (bool offsets : {false, true}) {
+      MrfProblem problem = RandomProblem(width, height, 6, 0.8f, 21 + width);
+      if (offsets) {
+        problem.truncation = 2.0f;
+        problem.label_step = 0.5f;
+        problem.label_offset.resize(problem.NumPixels());
+        for (size_t p = 0; p < problem.NumPixels(); ++p) problem.label_offset[p] = 0.3f * (p % 4);
+      }
+      MrfSolverOptions options;
+      options.solver = MrfSolverType::kBeliefPropagation;
+      options.bp_iterations = 4 * static_cast<int>(problem.NumPixels());
+      options.icm_polish_iterations = 0;
+      const MrfResult result = SolveMrf(problem, options, Context().get());
+      const double exact = ChainMinimum(problem);
+      EXPECT_NEAR(result.energy, exact, 1e-5 * std::abs(exact))
+          << width << " x " << height << (offsets ? ", offsets" : "");
+    }
+  }
+}
+
+// The device's solvers with their ICM polish end at a single-site minimum of the energy, as
+// computed here independently, also on degenerate shapes (one pixel, one row, one column, two
+// rows or columns) and label counts (1, 2).
+TEST(MrfSolvers, IcmPolishEndsAtASingleSiteMinimum) {
+  int seed = 40;
+  for (const auto& [width, height] :
+       {std::pair<int, int>{1, 1}, {40, 1}, {1, 40}, {33, 2}, {2, 33}, {9, 7}}) {
+    for (int num_labels : {1, 2, 5}) {
+      const MrfProblem problem = RandomProblem(width, height, num_labels, 0.6f, ++seed);
+      for (MrfSolverType type : {MrfSolverType::kSemiGlobal, MrfSolverType::kBeliefPropagation}) {
+        MrfSolverOptions options;
+        options.solver = type;
+        options.num_directions = 4;
+        options.icm_polish_iterations = 200;
+        const MrfResult result = SolveMrf(problem, options, Context().get());
+        ASSERT_EQ(result.labels.size(), problem.NumPixels());
+        EXPECT_NEAR(result.energy, MrfEnergy(problem, result.labels),
+                    1e-5 * std::max(1.0, std::abs(result.energy)));
+        std::string where;
+        EXPECT_TRUE(IsSingleSiteMinimum(problem, result.labels, &where))
+            << ToString(type) << " " << width << " x " << height << ", " << num_labels
+            << " labels: " << where;
+      }
+    }
+  }
+}
+
 TEST(BeliefPropagation, OpenCLMatchesCpuReference) {
   for (int variant = 0; variant < 4; ++variant) {
     const int icm = variant == 3 ? 20 : 0;
