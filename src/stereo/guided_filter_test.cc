@@ -20,7 +20,8 @@ float MaxAbsDiff(const FloatMap& a, const FloatMap& b) {
 TEST(GuidedFilter, BoxMeansMatchTheCpuReference) {
   auto context = OpenCLContext::Create();
   BoxFilterCL box(context.get());
-  for (int radius : {0, 1, 3, 7, 20}) {
+  // 30 and 50: windows past the image's height (23) and width (37), which the kernels clamp.
+  for (int radius : {0, 1, 3, 7, 20, 30, 50}) {
     const FloatMap input = RandomMap(37, 23, 3, 7 + radius);
     const size_t bytes = sizeof(float) * input.Data().size();
     cl::Buffer in(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR, bytes,
