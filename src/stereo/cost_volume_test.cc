@@ -90,6 +90,27 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
   EXPECT_LT(MaxAbsDiff(weighted_volume.Compute(weighted.base, 0.75f, 5, 7, labels), weighted_cpu),
             2e-4f);
   EXPECT_GT(MaxAbsDiff(weighted_cpu, plane), 0.05f);
+  // A source in the middle of the depth range, looking the same way: the labels' points nearer
+  // than 1.3 m lie behind it. And reference pixels without a field (outside the hair), as
+  // most are in real views.
+  Scene behind = scene;
+  behind.sources.push_back({LookAtCamera({0.3, 0, 1.3}, {0.3, 0, 2.3}, 100, 96, 72).PyramidLevel(1),
+                            RandomMap(48, 36, 2, 5, -1.0f)});
+  for (int row = 10; row < 20; ++row) {
+    for (int col = 5; col < 25; ++col) {
+      behind.ref.field.At(row, col, 0) = behind.ref.field.At(row, col, 1) = 0.0f;
+    }
+  }
+  for (OrientationTransfer transfer :
+       {OrientationTransfer::kEpipoleRoll, OrientationTransfer::kPlaneHomography}) {
+    CostVolumeCL behind_volume(context.get(), StereoCost::kOrientation, behind.ref,
+                               behind.sources, transfer);
+    const FloatMap behind_cpu = OrientationCostCpu(behind.ref, behind.sources, behind.base, 0.75f,
+                                                   0, 32, labels, transfer);
+    EXPECT_LT(MaxAbsDiff(behind_volume.Compute(behind.base, 0.75f, 0, 32, labels), behind_cpu),
+              2e-4f)
+        << "a source with points behind it, " << ToString(transfer);
+  }
   // Uniform-in-depth labels too.
   const DepthLabels linear(0.6, 2.0, 32, false);
   CostVolumeCL volume(context.get(), StereoCost::kOrientation, scene.ref, scene.sources,
