@@ -106,11 +106,12 @@ struct DepthEvaluationOptions {
   // the map's own finer errors. The medians of both are reported. 31 px: about the reach of the
   // coarsest level's aggregation window at 960 x 640. 0: not computed.
   int smooth_error_window_px = 31;
-  // Where a depth is compared with the truth. On: each depth is back-projected with the
-  // workspace's camera and projected into the view's true camera (gt/cameras.npz), and is
-  // compared, as a z-depth in that camera, with the truth of the true pixel it lands in (its
-  // label, true depth, silhouette distance and layer window); a hair pixel without a depth is
-  // missed at the true pixel of the same index. Off: every depth is compared with the true
+  // Where a depth is compared with the truth. On: in the view's true camera (gt/cameras.npz,
+  // at the map's size), each true hair pixel is compared with the map where its ray meets it:
+  // the map's point there, back-projected with the workspace's camera, as a z-depth in the true
+  // camera; a true hair pixel whose ray meets no depth is missing. So every true hair pixel
+  // counts once, as the same index does, rather than wherever the map's depths happen to
+  // land. Off: every depth is compared with the true
   // pixel of the same index. The two are the same where the workspace's cameras are the true
   // ones (the gantry sets: sparse/ holds the true poses); where they come from COLMAP's mapper
   // (synth_handheld: its poses are 0.24-0.43 degrees off the truth), the same index is a
@@ -139,8 +140,8 @@ struct DepthEvaluationOptions {
     v("smooth_error_window_px", &smooth_error_window_px,
       "k x k window (odd) whose mean signed error is the smooth part of the error (0 = off)");
     v("in_true_cameras", &in_true_cameras,
-      "compare each depth in the true camera's pixel it projects to (1) or at the pixel of "
-      "the same index (0)");
+      "compare each true hair pixel with the map where its ray meets it, in the true camera (1), "
+      "or with the map's pixel of the same index (0)");
   }
   bool Check(std::string* error) const;
 };

@@ -55,6 +55,32 @@ double MedianMm(const std::vector<double>& values_m) {
   return SummarizeDistances(values_m).median_mm;
 }
 
+// Where the ray of `true_camera`'s pixel (col, row) meets the depth map `depth` of `camera`
+// (the workspace's, whose pose may differ from the true one): from `start_depth` on, each step
+// takes the map's depth at the pixel where the ray's point projects, and moves along the ray to
+// that depth's z in the true camera; a few steps suffice, the two cameras being a fraction of a
+// degree apart. `*world` is the map's point met, `*true_depth` its z in the true camera. False
+// where the ray meets a pixel without a depth or leaves the map.
+bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
+                       const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
+                       double* true_depth) {
+  double z = start_depth;
+  for (int step = 0; step < 4; ++step) {
+    int map_col = 0, map_row = 0;
+    double map_z = 0;
+    if (!camera.Project(true_camera.BackProject(col, row, z), &map_col, &map_row, &map_z)) {
+      return false;
+    }
+    const float d = depth.At(map_row, map_col);
+    if (!(d > 0)) return false;
+    *world = camera.BackProject(map_col, map_row, d);
+    z = (true_camera.R * *world + true_camera.t).z();
+    if (!(z > 0)) return false;
+  }
+  *true_depth = z;
+  return true;
+}
+
 // The fraction of the true hair depths of the k x k window around gt pixel (r, c) that lie in
 // front of `depth` (ties count half); -1 when the window leaves the image or holds a pixel
 // that is not hair.
@@ -272,9 +298,13 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
     const StereoCamera camera =
         ws.ViewCamera(name).ScaledToMap(width, height, ws.DepthMapPath(name, options.depth_type));
+    // In the true camera, at the map's size: each of its hair pixels is compared where its ray
+    // meets the map (DepthAlongTrueRay), so that every true hair pixel counts once, with a
+    // depth or without.
     std::optional<StereoCamera> true_camera;
     if (options.in_true_cameras) {
-      true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);
+      true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
+                        .Scaled(width, height);
     }
 
     // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in
@@ -303,26 +333,30 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
     for (int r = 0; r < height; ++r) {
       const int same_row = std::min(gt_height - 1, (2 * r + 1) * gt_height / (2 * height));
       for (int c = 0; c < width; ++c) {
-        int gr = same_row;
-        int gc = std::min(gt_width - 1, (2 * c + 1) * gt_width / (2 * width));
-        const float d = depth.At(r, c);
-        // The depth compared: the map's own, or the point's z in the true camera.
+        const int gr = same_row;
+        const int gc = std::min(gt_width - 1, (2 * c + 1) * gt_width / (2 * width));
+        // The depth compared: the map's own at this pixel, or in the true camera the z of the
+        // map's point that this pixel's ray meets, followed from the map's depth here or else
+        // from the true one.
+        double compared_depth = depth.At(r, c);
         Eigen::Vector3d world = Eigen::Vector3d::Zero();
-        double compared_depth = d;
-        if (d > 0) {
-          world = camera.BackProject(c, r, d);
-          // A depth that lands outside the true image (or behind it) has no truth to meet.
-          if (true_camera && !true_camera->Project(world, &gc, &gr, &compared_depth)) continue;
+        bool has_estimate = compared_depth > 0;
+        if (true_camera) {
+          const double start = has_estimate ? compared_depth : gt.depth.At(gr, gc);
+          has_estimate = start > 0 && DepthAlongTrueRay(*true_camera, c, r, start, camera, depth,
+                                                        &world, &compared_depth);
+        } else if (has_estimate) {
+          world = camera.BackProject(c, r, compared_depth);
         }
         const uint8_t label = gt.label[static_cast<size_t>(gr) * gt_width + gc];
         cv::Vec3b& pixel = error_image.at<cv::Vec3b>(r, c);
         if (label != kLabelHair) {
           if (label == kLabelSkin) pixel = cv::Vec3b(40, 40, 40);
-          if (d > 0) pixel = cv::Vec3b(90, 60, 60);  // a depth outside the hair: blue-grey
+          if (has_estimate) pixel = cv::Vec3b(90, 60, 60);  // a depth outside the hair
           continue;
         }
         ++samples.num_hair_pixels;
-        if (!(d > 0)) {
+        if (!has_estimate) {
           pixel = cv::Vec3b(160, 160, 160);  // missing: grey
           continue;
         }

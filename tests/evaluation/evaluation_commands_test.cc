@@ -432,6 +432,23 @@ TEST(EvaluationCommands, DepthsOfAnOffPoseCameraComparedInTheTrueCamera) {
   EXPECT_GT(in_true.completeness, 0.9);
   options.in_true_cameras = false;
   const DepthMetrics same_index = EvaluateDepthMaps(out, scene.gt, options).overall;
+  // Either way the hair pixels are the true ones, each once: with or without a depth, not
+  // where the map's depths happen to land.
+  EXPECT_EQ(in_true.num_hair_pixels, same_index.num_hair_pixels);
+  // A map covering only part of the hair: the true hair pixels its rays do not meet count as
+  // missing in the true camera too.
+  FloatMap half = depth;
+  for (int r = 0; r < kHeight; ++r) {
+    for (int c = kWidth / 2; c < kWidth; ++c) half.At(r, c) = 0.0f;
+  }
+  WriteMat(Workspace::Read(out).DepthMapPath("v1.png"), half);
+  options.in_true_cameras = true;
+  const DepthMetrics half_in_true = EvaluateDepthMaps(out, scene.gt, options).overall;
+  EXPECT_EQ(half_in_true.num_hair_pixels, same_index.num_hair_pixels);
+  EXPECT_LT(half_in_true.completeness, 0.7 * in_true.completeness);
+  EXPECT_LT(half_in_true.mean_abs_error_mm, 0.05);
+  WriteMat(Workspace::Read(out).DepthMapPath("v1.png"), depth);
+  options.in_true_cameras = false;
   EXPECT_NEAR(same_index.median_signed_error_mm, -5.0, 0.1);
   // The 3D accuracy is of the same world points either way, but for the few at the hair's
   // edge that land on the background in one of the two.
