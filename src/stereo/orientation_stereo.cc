@@ -882,7 +882,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                     round + 1, 100 * consistent, static_cast<long long>(total.num_checked),
                     last_round ? ": the last round" : ": another round");
       } else {
-        std::printf("  round %d: no depths checked (no other view has a map)%s\n", round + 1,
+        // With no view estimated again, every view lacked some of the maps it is checked
+        // against (another job's, not written yet): the filter below says so per view.
+        std::printf("  round %d: no depths checked (%s)%s\n", round + 1,
+                    next.empty() ? "no view has all the maps it is checked against"
+                                 : "the estimates hold no depth",
                     last_round ? ": the last round" : ": another round");
       }
       previous_consistent = consistent;
