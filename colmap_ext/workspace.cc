@@ -376,18 +376,20 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
   }
   if (num_colour < static_cast<int>(channels.size())) {
     // A cut-out (a background-removal tool's PNG: the photo in colour, the mask as alpha)
-    // would keep everything by its colour, as COLMAP reads it; its alpha says otherwise. Where
-    // the two disagree beyond an antialiased rim, the file's meaning is not COLMAP's: refused.
-    const cv::Mat alpha_keeps = channels.back() != 0;
-    cv::Mat disagree;
-    cv::bitwise_xor(keep, alpha_keeps, disagree);
-    const double fraction = static_cast<double>(cv::countNonZero(disagree)) / keep.total();
+    // keeps by its colour, as COLMAP reads it, the pixels its alpha makes transparent. Where
+    // more than an antialiased rim is so, the file's meaning is not COLMAP's: refused. (An
+    // opaque alpha, as many editors write with a black and white mask, is no such case.)
+    const cv::Mat transparent = channels.back() == 0;
+    cv::Mat kept_but_transparent;
+    cv::bitwise_and(keep, transparent, kept_but_transparent);
+    const double fraction =
+        static_cast<double>(cv::countNonZero(kept_but_transparent)) / keep.total();
     THROW_IF(fraction > 0.01,
-             "Mask " << path << ": its alpha channel and its colour disagree on "
-                     << std::lround(100 * fraction) << "% of the pixels; COLMAP reads a mask "
-                     << "as a grey image (0 = excluded) and ignores alpha: write it as a grey "
-                        "PNG, 0 where excluded and 255 where kept (e.g. the alpha channel "
-                        "alone)");
+             "Mask " << path << ": " << std::lround(100 * fraction) << "% of its pixels are "
+                     << "transparent in its alpha channel but kept by their colour, as COLMAP "
+                     << "reads a mask (a grey image, 0 = excluded, alpha ignored): write it as "
+                        "a grey PNG, 0 where excluded and 255 where kept (e.g. the alpha "
+                        "channel alone)");
   }
   const int num_kept = cv::countNonZero(keep);
   THROW_IF(num_kept == 0, "Mask " << path << " excludes every pixel (all zero at " << keep.cols

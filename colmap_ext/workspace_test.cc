@@ -287,21 +287,25 @@ TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
             std::string::npos);
   EXPECT_EQ(ErrorOf([&] { ReadMask(wide, 600, 450); }).find("swapped"), std::string::npos);
 
-  // Alpha: a white-on-transparent mask (colour and alpha agree) is read by its colour; a cut-out
-  // (the photo in colour, the mask in alpha) is refused, where COLMAP would keep every pixel.
-  cv::Mat agree(8, 8, CV_8UC4, cv::Scalar(0, 0, 0, 0));
-  agree(cv::Rect(0, 0, 4, 8)).setTo(cv::Scalar(255, 255, 255, 255));
-  const std::string agree_path = JoinPaths(dir, "agree.png");
-  ASSERT_TRUE(cv::imwrite(agree_path, agree));
-  const FloatMap agreed = ReadMask(agree_path, 8, 8);
-  EXPECT_EQ(agreed.At(0, 0), 1.0f);
-  EXPECT_EQ(agreed.At(0, 7), 0.0f);
+  // Alpha: a white-on-transparent mask (colour and alpha agree) and a black and white one with
+  // an opaque alpha (as editors write) are read by their colour; a cut-out (the photo in colour,
+  // the mask in alpha) is refused, where COLMAP would keep every pixel.
+  for (const double background_alpha : {0.0, 255.0}) {
+    cv::Mat agree(8, 8, CV_8UC4, cv::Scalar(0, 0, 0, background_alpha));
+    agree(cv::Rect(0, 0, 4, 8)).setTo(cv::Scalar(255, 255, 255, 255));
+    const std::string agree_path = JoinPaths(dir, "agree.png");
+    ASSERT_TRUE(cv::imwrite(agree_path, agree));
+    const FloatMap agreed = ReadMask(agree_path, 8, 8);
+    EXPECT_EQ(agreed.At(0, 0), 1.0f) << background_alpha;
+    EXPECT_EQ(agreed.At(0, 7), 0.0f) << background_alpha;
+  }
   cv::Mat cut_out(8, 8, CV_8UC4, cv::Scalar(90, 120, 200, 0));
   cut_out(cv::Rect(0, 0, 4, 8)).setTo(cv::Scalar(90, 120, 200, 255));
   const std::string cut_out_path = JoinPaths(dir, "cut_out.png");
   ASSERT_TRUE(cv::imwrite(cut_out_path, cut_out));
   const std::string alpha_error = ErrorOf([&] { ReadMask(cut_out_path, 8, 8); });
-  EXPECT_NE(alpha_error.find("cut_out.png: its alpha channel and its colour disagree on 50%"),
+  EXPECT_NE(alpha_error.find("cut_out.png: 50% of its pixels are transparent in its alpha "
+                             "channel but kept by their colour"),
             std::string::npos)
       << alpha_error;
 }
