@@ -164,15 +164,29 @@ void RemoveTemporariesAndDie(int signal_number) {
   raise(signal_number);
 }
 
-std::string HostName() {
+// This host and its PID namespace, "<host name>~<namespace inode>": a process id names one
+// process only within both. Containers on one host may share its name but each have a PID
+// namespace of their own, with the same pids, so a run looks up the processes of the files of
+// its own host and namespace only.
+std::string HostTag() {
   char name[256] = {};
-  if (gethostname(name, sizeof(name) - 1) != 0 || name[0] == '\0') return "localhost";
-  return name;
+  std::string tag = gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0' ? name
+                                                                               : "localhost";
+  char link[64] = {};  // "pid:[4026531836]"
+  const ssize_t length = readlink("/proc/self/ns/pid", link, sizeof(link) - 1);
+  if (length > 0) {
+    const std::string text(link, static_cast<size_t>(length));
+    const size_t open = text.find('['), close = text.find(']');
+    if (open != std::string::npos && close != std::string::npos && close > open + 1) {
+      tag += "~" + text.substr(open + 1, close - open - 1);
+    }
+  }
+  return tag;
 }
 
-// Eight hex digits drawn once per process: with the pid and the host, a temporary's name is
-// unique to its process even among jobs in containers (a PID namespace each, so the same pids)
-// writing into one shared workspace.
+// Eight hex digits drawn once per process: with the pid and the host tag, a temporary's name is
+// unique to its process even among jobs on machines or in containers of one host name and
+// namespace inode writing into one shared workspace.
 const std::string& ProcessToken() {
   static const std::string token = [] {
     std::random_device random;
@@ -189,8 +203,8 @@ bool ProcessEnded(long pid) {
   return pid != getpid() && kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
 }
 
-// ".<stem>.tmp<pid>_<n>_<token>@<host><extension>" beside `path`: hidden, unique to this process
-// (ProcessToken), with the process and host that a later run needs to tell whether it was left
+// ".<stem>.tmp<pid>_<n>_<token>@<host tag><extension>" beside `path`: hidden, unique to this
+// process (ProcessToken), with the process and HostTag that a later run needs to tell whether it was left
 // by a run that was killed (RemoveTemporariesOfEndedRuns), and with the extension kept (OpenCV
 // picks the image format by it). The stem is shortened where the name would pass the file
 // system's 255-byte limit, which a long name near it otherwise would.
@@ -199,7 +213,7 @@ std::string TemporaryPathFor(const std::string& path) {
   constexpr size_t kMaxNameBytes = 255;
   const fs::path p(path);
   std::ostringstream suffix;
-  suffix << ".tmp" << getpid() << "_" << counter++ << "_" << ProcessToken() << "@" << HostName()
+  suffix << ".tmp" << getpid() << "_" << counter++ << "_" << ProcessToken() << "@" << HostTag()
          << p.extension().string();
   std::string stem = p.stem().string();
   const size_t room = kMaxNameBytes - std::min(kMaxNameBytes, 1 + suffix.str().size());
@@ -212,8 +226,8 @@ std::string TemporaryPathFor(const std::string& path) {
   return (p.parent_path() / ("." + stem + suffix.str())).string();
 }
 
-// The process of this host that made the temporary file `name` (TemporaryPathFor), or -1 for a
-// name of another host or no temporary's. A name of the older form without token and host,
+// The process of this host (and PID namespace: HostTag) that made the temporary file `name`
+// (TemporaryPathFor), or -1 for a name of another or no temporary's. A name of the older form without token and host,
 // ".<stem>.tmp<pid>_<n><extension>", counts as this host's, as ScratchDir's do.
 long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) {
   static const std::regex kCurrent(R"(\..*\.tmp([0-9]{1,9})_[0-9]+_[0-9a-f]{8})");
@@ -227,8 +241,10 @@ long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) 
     }
   }
   if (name.find('@') != std::string::npos) return -1;
-  const std::string front = name.substr(0, name.size() - extension.size());
-  if (std::regex_match(front, match, kOlder)) return std::stol(match[1].str());
+  // With its extension, or without one (where ".tmp<pid>_<n>" itself reads as the extension).
+  for (const std::string& front : {name.substr(0, name.size() - extension.size()), name}) {
+    if (std::regex_match(front, match, kOlder)) return std::stol(match[1].str());
+  }
   return -1;
 }
 
@@ -242,7 +258,7 @@ void RemoveTemporariesOfEndedRuns(const std::string& folder) {
     const std::lock_guard<std::mutex> lock(mutex);
     if (!done.insert(folder).second) return;
   }
-  const std::string host = HostName();
+  const std::string host = HostTag();
   std::error_code ec;
   for (const fs::directory_entry& entry : fs::directory_iterator(folder, ec)) {
     const std::string name = entry.path().filename().string();
@@ -378,7 +394,7 @@ void RemoveScratchOfEndedRuns(const std::string& parent, const std::string& pref
 
 ScratchDir::ScratchDir(const std::string& parent, const std::string& prefix) {
   static std::atomic<int> counter{0};
-  const std::string host = HostName();
+  const std::string host = HostTag();
   RemoveScratchOfEndedRuns(parent, prefix, host);
   path_ = JoinPaths(parent, prefix + std::to_string(getpid()) + "_" +
                                 std::to_string(counter++) + "@" + host);

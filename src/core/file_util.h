@@ -70,7 +70,8 @@ void CopyFilesAtomically(const std::vector<std::pair<std::string, std::string>>&
 // everything in it when destroyed. A process that a signal ends cannot remove it (the interrupt
 // handler removes files, which is async-signal-safe, not folder trees), so each new one first
 // removes the folders of the same prefix in `parent` whose process has ended, naming each in
-// the log; those of other hosts (a folder shared over the network) are left, since their
+// the log; those of other hosts (a folder shared over the network) or of other PID namespaces
+// of this host (containers: <host> is "<host name>~<PID namespace inode>") are left, since their
 // processes cannot be looked up from here.
 class ScratchDir {
  public:

@@ -291,9 +291,20 @@ TEST(FileUtil, ScratchDirRemovesTheFoldersOfEndedRunsOfThisHost) {
 // running processes and of other hosts, and other hidden files, are kept.
 TEST(FileUtil, AtomicWriteRemovesTheTemporariesOfEndedRunsOfThisHost) {
   const std::string dir = MakeTestDir("ended_temporaries");
+  // This host's tag, "<host name>~<PID namespace>", from a temporary written elsewhere (the
+  // first write into a folder cleans it, once).
+  std::string probe;
+  WritePathAtomically(JoinPaths(MakeTestDir("ended_temporaries_probe"), "p.bin"),
+                      [&](const std::string& tmp_path) {
+                        probe = tmp_path;
+                        std::ofstream(tmp_path) << "p";
+                      });
+  const size_t at = probe.rfind('@');
+  ASSERT_NE(at, std::string::npos) << probe;
+  const std::string host = probe.substr(at + 1, probe.size() - at - 1 - 4);  // less ".bin"
   char host_name[256] = {};
   ASSERT_EQ(gethostname(host_name, sizeof(host_name) - 1), 0);
-  const std::string host = host_name;
+  EXPECT_EQ(host.rfind(host_name, 0), 0u) << host;
   const pid_t ended = fork();
   if (ended == 0) _exit(0);
   ASSERT_EQ(waitpid(ended, nullptr, 0), ended);
@@ -301,10 +312,12 @@ TEST(FileUtil, AtomicWriteRemovesTheTemporariesOfEndedRunsOfThisHost) {
   const std::vector<std::string> removed = {
       ".a.tmp" + gone + "_3_0123abcd@" + host + ".bin",
       ".b.tmp" + gone + "_0_89abcdef@" + host,  // no extension
-      ".c.png.tmp" + gone + "_7.png"};          // the older form, without token and host
+      ".c.png.tmp" + gone + "_7.png",           // the older form, without token and host
+      ".d.tmp" + gone + "_2"};                  // the older form of a name without extension
   const std::vector<std::string> kept = {
       ".a.tmp1_0_0123abcd@" + host + ".bin",                 // init's: running
       ".a.tmp" + gone + "_0_0123abcd@another-" + host + ".bin",  // another host's
+      ".a.tmp" + gone + "_0_0123abcd@" + host_name + "~1.bin",  // another PID namespace's
       ".a.tmpx_0.bin",                                         // not a temporary's name
       ".hidden"};
   for (const auto* names : {&removed, &kept}) {
