@@ -1,6 +1,7 @@
 // hairmvs orientation_stereo: orientation-field depth maps of a COLMAP dense workspace.
 // hairmvs patch_match_stereo: the same, behind colmap patch_match_stereo's command line.
 
+#include <algorithm>
 #include <cctype>
 #include <cstdio>
 #include <functional>
@@ -11,6 +12,7 @@
 #include "hairmvs/orientation_fields.h"
 #include "hairmvs/orientation_stereo.h"
 #include "src/cli/command_registry.h"
+#include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
 #include "src/core/timer.h"
@@ -167,14 +169,52 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
       {"PatchMatchStereo.filter_geom_consistency_max_cost", "geom_consistency_max_error_px",
        [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
   };
-  for (const MappedOption& option : mapped) {
-    if (parser.WasGiven(option.colmap_name)) option.apply();
+  // A project file that colmap wrote lists every option, most at colmap's defaults: where
+  // hairmvs's differ on purpose (OrientationStereoOptions says why), colmap's from the file are
+  // left to them; given on the command line they apply.
+  struct ColmapDefault {
+    const char* name;
+    double colmap_default;
+    double value;
+  };
+  const ColmapDefault colmap_defaults[] = {
+      {"PatchMatchStereo.filter_min_num_consistent", 2,
+       static_cast<double>(filter_min_num_consistent)},
+      {"PatchMatchStereo.filter_geom_consistency_max_cost", 1, filter_geom_consistency_max_cost},
+      {"PatchMatchStereo.geom_consistency_max_cost", 3, geom_consistency_max_cost}};
+  std::vector<std::string> left_to_hairmvs;
+  for (const ColmapDefault& option : colmap_defaults) {
+    if (parser.FromProjectFile(option.name) && option.value == option.colmap_default) {
+      left_to_hairmvs.push_back(option.name);
+    }
   }
-  if ((depth_min > 0) != (depth_max > 0)) {
-    // A script written for colmap may rely on its rule; the bound given is not dropped here.
+  if (!left_to_hairmvs.empty()) {
+    LOG(INFO) << "the project file's " << JoinStrings(left_to_hairmvs, ", ")
+              << " are colmap's defaults: hairmvs's own apply (give them on the command line "
+                 "to override)";
+  }
+  for (const MappedOption& option : mapped) {
+    if (parser.WasGiven(option.colmap_name) &&
+        std::find(left_to_hairmvs.begin(), left_to_hairmvs.end(), option.colmap_name) ==
+            left_to_hairmvs.end()) {
+      option.apply();
+    }
+  }
+  // The geometric pass alone redoes the .geometric maps that exist: colmap's resume does not
+  // apply to it (OrientationStereoOptions::skip_existing), unless asked for.
+  if (options.geom_consistency_only && !parser.WasGiven("OrientationStereo.skip_existing")) {
+    options.skip_existing = false;
+  }
+  // colmap takes the range as given only when both bounds are >= 0; hairmvs takes each bound
+  // > 0 as given and computes the others. A script written for colmap may rely on its rule.
+  if ((depth_min < 0) != (depth_max < 0)) {
     LOG(WARNING) << "one depth bound given (--PatchMatchStereo.depth_min " << depth_min
                  << ", depth_max " << depth_max << "): colmap would compute both from the "
                  << "sparse points; hairmvs keeps the one given and computes the other";
+  } else if (depth_min == 0 || depth_max == 0) {
+    LOG(WARNING) << "--PatchMatchStereo.depth_min " << depth_min << ", depth_max " << depth_max
+                 << ": a bound of 0 is no depth; hairmvs computes it, where colmap would take "
+                    "it as given";
   }
   // As colmap's: without its geometric pass the maps are named .photometric.
   if (!parser.WasGiven("OrientationStereo.single_pass_type")) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <set>
 #include <sstream>
 #include <type_traits>
 
@@ -34,6 +35,8 @@ struct OptionParser::Impl {
   std::map<std::string, std::function<bool()>> finite_checks;
   // AddProjectPath's sections; empty without it.
   std::vector<std::string> project_sections;
+  // The options whose value the project file gave.
+  std::set<std::string> from_project_file;
 };
 
 OptionParser::OptionParser(std::string command, std::string description)
@@ -145,6 +148,7 @@ void OptionParser::AddIgnored(const std::string& name, const std::string& why) {
 }
 
 void OptionParser::AddProjectPath(const std::vector<std::string>& sections) {
+  CHECK(!sections.empty()) << "AddProjectPath needs the sections the file's options may set";
   impl_->desc.add_options()("project_path", po::value<std::string>(),
                             "colmap project .ini file of options (those given here win)");
   impl_->project_sections = sections;
@@ -203,10 +207,13 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
         const std::string& key = option.string_key;
         // Given on the command line: that value wins.
         if (impl_->vm.count(key) && !impl_->vm[key].defaulted()) continue;
-        const bool in_sections = InSections(key, impl_->project_sections);
         if (!option.unregistered && impl_->ignored.count(key) == 0) {
           used.push_back(key + "=" + (option.value.empty() ? "" : option.value.front()));
-        } else if (in_sections) {
+          impl_->from_project_file.insert(key);
+        } else if (impl_->ignored.count(key) > 0 ||
+                   InSections(key, impl_->project_sections)) {
+          // Ignored here (colmap's top-level log_level too), or unknown in our sections; other
+          // commands' sections are passed over.
           not_used.push_back(key);
           impl_->ignored.erase(key);
         }
@@ -248,6 +255,10 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
 
 bool OptionParser::WasGiven(const std::string& name) const {
   return impl_->vm.count(name) && !impl_->vm[name].defaulted();
+}
+
+bool OptionParser::FromProjectFile(const std::string& name) const {
+  return impl_->from_project_file.count(name) > 0;
 }
 
 std::string OptionParser::Help() const {

@@ -72,6 +72,8 @@ class OptionParser {
   // Throws hairmvs::Error on an unknown option, a missing value or a bad value.
   bool Parse(int argc, char** argv, int first = 2);
   bool WasGiven(const std::string& name) const;
+  // Whether `name`'s value came from the --project_path file (not the command line).
+  bool FromProjectFile(const std::string& name) const;
   std::string Help() const;
   // "name = value" lines for the values in use, for logs.
   std::string Values() const;

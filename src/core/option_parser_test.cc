@@ -79,7 +79,7 @@ TEST(OptionParser, ProjectFileAsColmapsWithTheCommandLineWinning) {
   const std::string dir = testing_util::MakeTestDir("project_path");
   const std::string ini = JoinPaths(dir, "project.ini");
   WriteFileAtomically(ini, [](std::ostream& out) {
-    out << "log_to_stderr=true\nworkspace_path=/from/ini\n[SiftExtraction]\nmax_num_features="
+    out << "log_level=2\nworkspace_path=/from/ini\n[SiftExtraction]\nmax_num_features="
            "8192\n[Toy]\nlambda=0.75\nnum_levels=5\nwrite_png=True\nwindow_radius=5\n"
            "gpu_index=-1\n";
   });
@@ -89,6 +89,7 @@ TEST(OptionParser, ProjectFileAsColmapsWithTheCommandLineWinning) {
   parser.Add("workspace_path", &workspace, "workspace", /*required=*/true);
   parser.AddSection("Toy", &options);
   parser.AddIgnored("Toy.gpu_index", "no such thing here");
+  parser.AddIgnored("log_level", "logs always");
   parser.AddProjectPath({"Toy"});
   std::vector<std::string> args = {"hairmvs", "toy", "--project_path", ini, "--Toy.num_levels",
                                    "2"};
@@ -101,8 +102,11 @@ TEST(OptionParser, ProjectFileAsColmapsWithTheCommandLineWinning) {
   EXPECT_EQ(options.num_levels, 2);  // the command line's
   EXPECT_TRUE(options.write_png);
   EXPECT_TRUE(parser.WasGiven("Toy.lambda"));
-  EXPECT_NE(log.find("2 of its options have no effect"), std::string::npos) << log;
-  EXPECT_NE(log.find("Toy.window_radius, Toy.gpu_index"), std::string::npos) << log;
+  EXPECT_NE(log.find("3 of its options have no effect"), std::string::npos) << log;
+  EXPECT_NE(log.find("log_level, Toy.window_radius, Toy.gpu_index"), std::string::npos) << log;
+  EXPECT_EQ(log.find("--log_level is ignored"), std::string::npos) << log;
+  EXPECT_TRUE(parser.FromProjectFile("Toy.lambda"));
+  EXPECT_FALSE(parser.FromProjectFile("Toy.num_levels"));  // the command line's
   EXPECT_NE(log.find("options taken from it: workspace_path=/from/ini, Toy.lambda=0.75, "
                      "Toy.write_png=True\n"),
             std::string::npos)

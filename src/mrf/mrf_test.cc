@@ -374,8 +374,6 @@ TEST(SemiGlobal, PathMinimumEqualsBruteForce) {
   }
 }
 
-// The OpenCL belief propagation (with and without the ICM polish on the device) equals its
-// CPU reference.
 // Independent of the kernels' CPU copies: on a chain (a tree), min-sum belief propagation is
 // exact, so the device's labels reach the dynamic programme's minimum; rows and columns, with
 // label offsets and truncation.
@@ -428,6 +426,8 @@ TEST(MrfSolvers, IcmPolishEndsAtASingleSiteMinimum) {
   }
 }
 
+// The OpenCL belief propagation (with and without the ICM polish on the device) equals its
+// CPU reference.
 TEST(BeliefPropagation, OpenCLMatchesCpuReference) {
   for (int variant = 0; variant < 4; ++variant) {
     const int icm = variant == 3 ? 20 : 0;

@@ -160,7 +160,7 @@ void ExpectMatchesReference(const Reference& ref, const FloatMap& kernel,
               "%d tie(s), %d zero(s)\n", what.c_str(), compared, worst_relative, worst_angle, ties,
               zeros);
   // The bright-strands rule zeroes the pixels of dark strands, which MixedImage has.
-  if (options.dark_strands == false) {
+  if (!options.dark_strands) {
     EXPECT_GT(zeros, 0) << what;
   }
   EXPECT_GT(compared, static_cast<int>(gray.NumPixels() / 4)) << what;

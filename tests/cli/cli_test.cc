@@ -185,6 +185,25 @@ TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
   EXPECT_NE(output.text.find("(max_image_size is set by --PatchMatchStereo.max_image_size)"),
             std::string::npos)
       << output.text;
+  // A project file as colmap writes it: its options apply, but colmap's defaults where
+  // hairmvs's differ on purpose leave hairmvs's, so the maps are the defaults' ones.
+  const std::string ini = JoinPaths(dir, "project.ini");
+  WriteFileAtomically(ini, [](std::ostream& out) {
+    out << "log_level=2\n[PatchMatchStereo]\ngeom_consistency=true\nfilter=true\n"
+           "max_image_size=-1\nwindow_radius=5\nfilter_min_num_consistent=2\n"
+           "geom_consistency_max_cost=3\nfilter_geom_consistency_max_cost=1\n[StereoFusion]\n"
+           "min_num_pixels=5\n";
+  });
+  output = RunHairmvs(run + " --project_path " + ini);
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_NE(output.text.find("are colmap's defaults: hairmvs's own apply"), std::string::npos)
+      << output.text;
+  EXPECT_EQ(num_depths("geometric"), filtered);
+  // The geometric pass alone runs without the resume colmap's drop-in turns on by default.
+  output = RunHairmvs("patch_match_stereo --workspace_path " + workspace +
+                      " --OrientationStereo.geom_consistency_only 1");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_EQ(num_depths("geometric"), filtered);
   std::filesystem::remove_all(dir);
 }
 
