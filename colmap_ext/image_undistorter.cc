@@ -235,12 +235,8 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
     masked.push_back(name);
   }
   list.close();
-  // A mask folder given that matches no photo is a wrong folder or naming, not "0 masks".
-  THROW_IF(masked.empty(), "No mask in " << mask_path << " belongs to a photo of " << input_path
-                                         << " (COLMAP's naming: <photo name>.png, e.g. "
-                                         << JoinPaths(mask_path,
-                                                      workspace.ImageNames().front() + ".png")
-                                         << "); nothing was written");
+  // (A mask folder that matches no photo, a wrong folder or naming, was refused by
+  // Workspace::Read above.)
   // Masks already there may be drawn by hand: replaced only when asked, and named before
   // colmap runs.
   if (!overwrite) {

@@ -66,6 +66,14 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
                                                          ws.image_names_.front() + ".png")
                                   << " (COLMAP's naming: <image name>.png)");
     }
+    // A folder given for the masks that holds none is a wrong folder; the workspace's own
+    // masks/ left empty is taken as no masks (warned about below).
+    THROW_IF(!mask_path.empty(),
+             "No mask in " << ws.mask_path_ << " (the mask folder given) belongs to an image of "
+                           << "the workspace: it holds no image file; the mask of the image "
+                           << ws.image_names_.front() << " is "
+                           << JoinPaths(ws.mask_path_, ws.image_names_.front() + ".png")
+                           << " (COLMAP's naming: <image name>.png)");
   }
   if (!unmasked.empty()) {
     // COLMAP skips a missing mask silently; here a view without one lets its background into

@@ -73,11 +73,13 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_NE(ErrorOf([&] { Workspace::Read(dir, JoinPaths(dir, "nomasks")); }).find("nomasks"),
             std::string::npos);
   // Masks named for no image (the image's stem, the usual slip): an error with COLMAP's naming,
-  // not a run without masks. Other files do not count; a folder without images is a warning.
+  // not a run without masks; so is a mask folder given that holds no image file (other files
+  // do not count).
   const std::string stems = JoinPaths(dir, "stem_masks");
   std::filesystem::create_directories(stems);
   std::ofstream(JoinPaths(stems, "notes.txt")) << "drawn by hand";
-  EXPECT_EQ(Workspace::Read(dir, stems).ImagesWithoutMask().size(), 3u);
+  EXPECT_NE(ErrorOf([&] { Workspace::Read(dir, stems); }).find("it holds no image file"),
+            std::string::npos);
   cv::imwrite(JoinPaths(stems, "a.jpg"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
   const std::string stem_error = ErrorOf([&] { Workspace::Read(dir, stems); });
   EXPECT_NE(stem_error.find("No mask in " + stems + " belongs to an image"), std::string::npos)
