@@ -150,23 +150,29 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   // when a value they set is refused.
   struct MappedOption {
     const char* colmap_name;
+    const char* section;  // of the hairmvs option it sets: <section>.<field>
     const char* field;
     std::function<void()> apply;
   };
   const std::vector<MappedOption> mapped = {
-      {"PatchMatchStereo.max_image_size", "max_image_size",
+      {"PatchMatchStereo.max_image_size", "OrientationStereo", "max_image_size",
        [&] { options.max_image_size = max_image_size; }},
-      {"PatchMatchStereo.depth_min", "depth_min", [&] { options.depth_min = depth_min; }},
-      {"PatchMatchStereo.depth_max", "depth_max", [&] { options.depth_max = depth_max; }},
-      {"PatchMatchStereo.min_triangulation_angle", "min_triangulation_angle_deg",
+      {"PatchMatchStereo.depth_min", "OrientationStereo", "depth_min",
+       [&] { options.depth_min = depth_min; }},
+      {"PatchMatchStereo.depth_max", "OrientationStereo", "depth_max",
+       [&] { options.depth_max = depth_max; }},
+      {"PatchMatchStereo.min_triangulation_angle", "SourceViews", "min_triangulation_angle_deg",
        [&] { source_options.min_triangulation_angle_deg = min_triangulation_angle; }},
-      {"PatchMatchStereo.geom_consistency", "geom_consistency",
+      {"PatchMatchStereo.geom_consistency", "OrientationStereo", "geom_consistency",
        [&] { options.geom_consistency = geom_consistency; }},
-      {"PatchMatchStereo.geom_consistency_max_cost", "geom_prior_max_error_px",
+      {"PatchMatchStereo.geom_consistency_max_cost", "OrientationStereo",
+       "geom_prior_max_error_px",
        [&] { options.geom_prior_max_error_px = geom_consistency_max_cost; }},
-      {"PatchMatchStereo.filter_min_num_consistent", "geom_consistency_min_views",
+      {"PatchMatchStereo.filter_min_num_consistent", "OrientationStereo",
+       "geom_consistency_min_views",
        [&] { options.geom_consistency_min_views = filter_min_num_consistent; }},
-      {"PatchMatchStereo.filter_geom_consistency_max_cost", "geom_consistency_max_error_px",
+      {"PatchMatchStereo.filter_geom_consistency_max_cost", "OrientationStereo",
+       "geom_consistency_max_error_px",
        [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
   };
   // A project file that colmap wrote lists every option, most at colmap's defaults: where
@@ -190,15 +196,28 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   }
   if (!left_to_hairmvs.empty()) {
     LOG(INFO) << "the project file's " << JoinStrings(left_to_hairmvs, ", ")
-              << " are colmap's defaults: hairmvs's own apply (give them on the command line "
-                 "to override)";
+              << " are colmap's defaults: not applied, hairmvs's own apply (give them on the "
+                 "command line to override)";
   }
+  // The command line wins over the file: a file's value is not applied over the hairmvs option
+  // it sets when that option is given.
+  std::vector<std::string> overridden;
   for (const MappedOption& option : mapped) {
-    if (parser.WasGiven(option.colmap_name) &&
-        std::find(left_to_hairmvs.begin(), left_to_hairmvs.end(), option.colmap_name) ==
+    if (!parser.WasGiven(option.colmap_name) ||
+        std::find(left_to_hairmvs.begin(), left_to_hairmvs.end(), option.colmap_name) !=
             left_to_hairmvs.end()) {
-      option.apply();
+      continue;
     }
+    const std::string own = std::string(option.section) + "." + option.field;
+    if (parser.FromProjectFile(option.colmap_name) && parser.WasGiven(own)) {
+      overridden.push_back(std::string(option.colmap_name) + " (--" + own + " given)");
+      continue;
+    }
+    option.apply();
+  }
+  if (!overridden.empty()) {
+    LOG(INFO) << "the project file's " << JoinStrings(overridden, ", ")
+              << ": not applied, the command line's option wins";
   }
   // The geometric pass alone redoes the .geometric maps that exist: colmap's resume does not
   // apply to it (OrientationStereoOptions::skip_existing), unless asked for.
@@ -207,14 +226,14 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   }
   // colmap takes the range as given only when both bounds are >= 0; hairmvs takes each bound
   // > 0 as given and computes the others. A script written for colmap may rely on its rule.
-  if ((depth_min < 0) != (depth_max < 0)) {
+  if (depth_min == 0 || depth_max == 0) {
+    LOG(WARNING) << "--PatchMatchStereo.depth_min " << depth_min << ", depth_max " << depth_max
+                 << ": a bound of 0 is no depth; hairmvs computes it, where colmap would take "
+                    "it as given (with the other >= 0)";
+  } else if ((depth_min < 0) != (depth_max < 0)) {
     LOG(WARNING) << "one depth bound given (--PatchMatchStereo.depth_min " << depth_min
                  << ", depth_max " << depth_max << "): colmap would compute both from the "
                  << "sparse points; hairmvs keeps the one given and computes the other";
-  } else if (depth_min == 0 || depth_max == 0) {
-    LOG(WARNING) << "--PatchMatchStereo.depth_min " << depth_min << ", depth_max " << depth_max
-                 << ": a bound of 0 is no depth; hairmvs computes it, where colmap would take "
-                    "it as given";
   }
   // As colmap's: without its geometric pass the maps are named .photometric.
   if (!parser.WasGiven("OrientationStereo.single_pass_type")) {
@@ -230,10 +249,15 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
          {"OrientationStereo.filter_range_ends", "OrientationStereo.min_confidence",
           "OrientationStereo.geom_consistency_min_views"}) {
       THROW_IF(parser.WasGiven(filtering),
-               "hairmvs patch_match_stereo: --PatchMatchStereo.filter 0 keeps every estimate; "
-               "--" << filtering << " filters them: give one or the other");
+               "hairmvs patch_match_stereo: --PatchMatchStereo.filter 0"
+                   << (parser.FromProjectFile("PatchMatchStereo.filter") ? " (project file)"
+                                                                         : "")
+                   << " keeps every estimate; --" << filtering
+                   << " filters them: give one or the other");
     }
-    if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent")) {
+    // A project file lists the option whatever its filter says: no warning for that.
+    if (parser.WasGiven("PatchMatchStereo.filter_min_num_consistent") &&
+        !parser.FromProjectFile("PatchMatchStereo.filter_min_num_consistent")) {
       LOG(WARNING) << "--PatchMatchStereo.filter_min_num_consistent is ignored with "
                       "--PatchMatchStereo.filter 0, as colmap ignores it";
     }

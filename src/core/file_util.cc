@@ -233,8 +233,11 @@ long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) 
   static const std::regex kCurrent(R"(\..*\.tmp([0-9]{1,9})_[0-9]+_[0-9a-f]{8})");
   static const std::regex kOlder(R"(\..*\.tmp([0-9]{1,9})_[0-9]+)");
   const std::string extension = fs::path(name).extension().string();
+  // The host name alone: the form before the PID namespace was part of the tag.
+  const std::string host_name = host.substr(0, host.find('~'));
   std::smatch match;
-  for (const std::string& end : {"@" + host + extension, "@" + host}) {
+  for (const std::string& end : {"@" + host + extension, "@" + host, "@" + host_name + extension,
+                                 "@" + host_name}) {
     if (name.size() > end.size() && name.compare(name.size() - end.size(), end.size(), end) == 0) {
       const std::string front = name.substr(0, name.size() - end.size());
       if (std::regex_match(front, match, kCurrent)) return std::stol(match[1].str());
@@ -381,7 +384,11 @@ void RemoveScratchOfEndedRuns(const std::string& parent, const std::string& pref
     const size_t digits = std::min(rest.find_first_not_of("0123456789"), rest.size());
     if (digits == 0 || digits > 9 || digits == rest.size() || rest[digits] != '_') continue;
     const size_t at = rest.find('@', digits);
-    if (at != std::string::npos && rest.substr(at + 1) != host) continue;
+    // The host name alone (the form before the PID namespace was part of the tag) counts too.
+    if (at != std::string::npos && rest.substr(at + 1) != host &&
+        rest.substr(at + 1) != host.substr(0, host.find('~'))) {
+      continue;
+    }
     const long pid = std::stol(rest.substr(0, digits));
     if (!ProcessEnded(pid)) continue;
     LOG(INFO) << "Removing " << entry.path().string() << ", left by a run (process " << pid

@@ -269,6 +269,8 @@ TEST(FileUtil, ScratchDirRemovesTheFoldersOfEndedRunsOfThisHost) {
   const std::vector<std::string> kept = {
       ".set.staging1_0@" + host,                     // init's: running
       ".set.staging" + gone + "_0@another-" + host,  // its process cannot be looked up
+      ".set.staging" + gone + "_0@" + host.substr(0, host.find('~')) + "~1",  // another PID
+                                                                             // namespace's
       ".other.staging" + gone + "_0@" + host,        // another prefix
       ".set.stagingx_0@" + host};                    // not a scratch name
   for (const auto* names : {&removed, &kept}) {
@@ -313,7 +315,8 @@ TEST(FileUtil, AtomicWriteRemovesTheTemporariesOfEndedRunsOfThisHost) {
       ".a.tmp" + gone + "_3_0123abcd@" + host + ".bin",
       ".b.tmp" + gone + "_0_89abcdef@" + host,  // no extension
       ".c.png.tmp" + gone + "_7.png",           // the older form, without token and host
-      ".d.tmp" + gone + "_2"};                  // the older form of a name without extension
+      ".d.tmp" + gone + "_2",                   // the older form of a name without extension
+      ".e.tmp" + gone + "_1_0123abcd@" + host_name + ".bin"};  // the host name alone (older)
   const std::vector<std::string> kept = {
       ".a.tmp1_0_0123abcd@" + host + ".bin",                 // init's: running
       ".a.tmp" + gone + "_0_0123abcd@another-" + host + ".bin",  // another host's

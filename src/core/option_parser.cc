@@ -219,7 +219,7 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
         }
       }
       po::store(from_file, impl_->vm);
-      LOG(INFO) << path << ": options taken from it: "
+      LOG(INFO) << path << ": options read from it: "
                 << (used.empty() ? "none" : JoinStrings(used, ", "));
       if (!not_used.empty()) {
         LOG(WARNING) << path << ": " << not_used.size() << " of its options have no effect "

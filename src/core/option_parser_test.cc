@@ -107,7 +107,7 @@ TEST(OptionParser, ProjectFileAsColmapsWithTheCommandLineWinning) {
   EXPECT_EQ(log.find("--log_level is ignored"), std::string::npos) << log;
   EXPECT_TRUE(parser.FromProjectFile("Toy.lambda"));
   EXPECT_FALSE(parser.FromProjectFile("Toy.num_levels"));  // the command line's
-  EXPECT_NE(log.find("options taken from it: workspace_path=/from/ini, Toy.lambda=0.75, "
+  EXPECT_NE(log.find("options read from it: workspace_path=/from/ini, Toy.lambda=0.75, "
                      "Toy.write_png=True\n"),
             std::string::npos)
       << log;

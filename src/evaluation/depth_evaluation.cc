@@ -58,9 +58,10 @@ double MedianMm(const std::vector<double>& values_m) {
 // Where the ray of `true_camera`'s pixel (col, row) meets the depth map `depth` of `camera`
 // (the workspace's, whose pose may differ from the true one): from `start_depth` on, each step
 // takes the map's depth at the pixel where the ray's point projects, and moves along the ray to
-// that depth's z in the true camera; a few steps suffice, the two cameras being a fraction of a
-// degree apart. `*world` is the map's point met, `*true_depth` its z in the true camera. False
-// where the ray meets a pixel without a depth or leaves the map.
+// that depth's z in the true camera, four steps: the two cameras being a fraction of a degree
+// apart, the pixel met settles in one or two, and at a depth edge, where it may alternate
+// between two pixels, the last is taken. `*world` is the map's point met, `*true_depth` its z
+// in the true camera. False where the ray meets a pixel without a depth or leaves the map.
 bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
                        const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
                        double* true_depth) {

@@ -196,9 +196,21 @@ TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
   });
   output = RunHairmvs(run + " --project_path " + ini);
   ASSERT_EQ(output.exit_code, 0) << output.text;
-  EXPECT_NE(output.text.find("are colmap's defaults: hairmvs's own apply"), std::string::npos)
+  EXPECT_NE(output.text.find("are colmap's defaults: not applied"), std::string::npos)
       << output.text;
   EXPECT_EQ(num_depths("geometric"), filtered);
+  // The command line's hairmvs option wins over the file's colmap one that sets it.
+  output = RunHairmvs(run + " --project_path " + ini + " --OrientationStereo.max_image_size 80");
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_EQ(
+      ReadMat(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png.geometric.bin")).Width(),
+      80);
+  EXPECT_NE(output.text.find("PatchMatchStereo.max_image_size (--OrientationStereo.max_image_size "
+                             "given): not applied"),
+            std::string::npos)
+      << output.text;
+  output = RunHairmvs(run);  // the maps of the defaults again
+  ASSERT_EQ(output.exit_code, 0) << output.text;
   // The geometric pass alone runs without the resume colmap's drop-in turns on by default.
   output = RunHairmvs("patch_match_stereo --workspace_path " + workspace +
                       " --OrientationStereo.geom_consistency_only 1");
