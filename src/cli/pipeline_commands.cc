@@ -114,15 +114,23 @@ int RunPipeline(int argc, char** argv) {
       std::fprintf(stderr, "[pipeline] undistorted %d mask(s) of %s into %s\n", masks.num_masks,
                    photo_mask_path.c_str(), JoinPaths(workspace_path, "masks").c_str());
     }
-  } else {
-    THROW_IF(!photo_mask_path.empty(),
+  } else if (!photo_mask_path.empty()) {
+    // The same command run again (to finish a stopped run): the masks it undistorted are there.
+    const bool all_masked = ExistsDir(JoinPaths(workspace_path, "masks")) &&
+                            Workspace::Read(workspace_path).ImagesWithoutMask().empty();
+    THROW_IF(!all_masked,
              "--photo_mask_path " << photo_mask_path
                  << " holds masks of the photos, undistorted only when the workspace is "
                     "created; "
-                 << workspace_path << " exists: run `hairmvs undistort_masks "
-                 << "--workspace_path " << workspace_path << " --input_path <its sparse model> "
-                 << "--photo_mask_path " << photo_mask_path << "`, or put masks drawn on its "
-                 << "images in " << workspace_path << "/masks");
+                 << workspace_path << " exists without a mask for every image: run `hairmvs "
+                 << "undistort_masks --workspace_path " << workspace_path
+                 << " --input_path <its sparse model> --photo_mask_path " << photo_mask_path
+                 << "` (with --overwrite 1 to replace the masks it has), or put masks drawn on "
+                 << "its images in " << workspace_path << "/masks");
+    std::fprintf(stderr,
+                 "[pipeline] %s exists with a mask for every image in %s/masks: those are used "
+                 "(--photo_mask_path is undistorted only when the workspace is created)\n",
+                 workspace_path.c_str(), workspace_path.c_str());
   }
 
   if (HasStage(stages, "stereo") || HasStage(stages, "fusion")) {

@@ -13,6 +13,7 @@
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/test_util.h"
+#include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
 
 namespace hairmvs {
@@ -149,6 +150,40 @@ TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
   ASSERT_EQ(output.exit_code, 0) << output.text;
   ExpectRunSummary(output.text, {"true strands", "read maps and truth", "per-pixel errors",
                                  "3D distances", "error pictures", "summary"});
+  std::filesystem::remove_all(dir);
+}
+
+// The pipeline from photos with masks drawn on them, run again as the README says to finish a
+// stopped run: the workspace it made holds a mask for every image, so the second run goes on
+// with those rather than refusing --photo_mask_path.
+TEST(Cli, PipelineFromPhotosWithMasksRunsAgain) {
+  const std::string dir = testing_util::MakeTestDir("cli_pipeline_photo_masks");
+  const std::string set = SynthesizeSmallSet(dir);
+  // The set's undistorted images and model stand for the photos (PINHOLE: undistorting keeps
+  // them), its masks for the masks drawn on them (<photo name>.png).
+  const std::string photo_masks = JoinPaths(dir, "photo_masks");
+  CreateDirs(photo_masks);
+  for (const auto& entry : std::filesystem::directory_iterator(JoinPaths(set, "masks"))) {
+    const std::string name = entry.path().filename().string();  // <image>.png.png
+    std::filesystem::copy_file(entry.path(),
+                               JoinPaths(photo_masks, name.substr(0, name.size() - 4)));
+  }
+  const std::string dense = JoinPaths(dir, "from_photos");
+  const std::string run = "pipeline --workspace_path " + dense + " --image_path " +
+                          JoinPaths(set, "images") + " --input_path " + JoinPaths(set, "sparse") +
+                          " --photo_mask_path " + photo_masks + " --stages orientation";
+  CommandOutput output = RunHairmvs(run);
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_TRUE(Workspace::Read(dense).ImagesWithoutMask().empty());
+  output = RunHairmvs(run);
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  EXPECT_NE(output.text.find("exists with a mask for every image"), std::string::npos)
+      << output.text;
+  // Without a mask for some image it is refused, naming undistort_masks.
+  std::filesystem::remove(JoinPaths(dense, "masks", "g0_c.png.png"));
+  output = RunHairmvs(run);
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("undistort_masks"), std::string::npos) << output.text;
   std::filesystem::remove_all(dir);
 }
 
