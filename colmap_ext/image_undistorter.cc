@@ -171,6 +171,9 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   RequireDir(input_path, "sparse model folder (--input_path)");
   THROW_IF(ExistsDir(JoinPaths(workspace_path, "sparse")),
            "Not creating the workspace " << workspace_path << ": it has a sparse/ model already");
+  // The model read first: a folder that holds none (the mapper's sparse/ given for its
+  // sparse/0, say) is named here, where colmap would abort with a stack trace.
+  const Reconstruction model = ReadReconstruction(input_path);
   // Symlinks resolved: a workspace path that links to another file system is staged beside
   // where its entries will live, so that they are renamed there, not across file systems.
   fs::path target = fs::weakly_canonical(fs::absolute(workspace_path));
@@ -181,13 +184,15 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   const ScratchDir staging(target.parent_path().string(),
                            "." + target.filename().string() + ".undistorting");
   const int status = Undistort(colmap_executable, image_path, input_path, staging.Path());
+  // (colmap itself was found and started: RequireExecutable; its own messages say why it
+  // failed.)
   THROW_IF(status != 0, "colmap image_undistorter " << DescribeStatus(status)
                             << " for --image_path " << image_path << " --input_path "
-                            << input_path << "; is COLMAP installed (apt-get install colmap)? "
+                            << input_path << " (see colmap's messages above). "
                             << "Nothing was written to " << workspace_path);
   // colmap image_undistorter passes over a photo it cannot read ("Cannot read image") and
   // still exits 0; a workspace without it would fail every later command.
-  for (const auto& [id, image] : ReadReconstruction(input_path).images) {
+  for (const auto& [id, image] : model.images) {
     THROW_IF(!ExistsFile(JoinPaths(staging.Path(), "images", image.name)),
              "colmap image_undistorter wrote no image for "
                  << JoinPaths(image_path, image.name) << ", which the model " << input_path

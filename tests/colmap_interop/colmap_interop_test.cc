@@ -409,6 +409,14 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
       << error;
   EXPECT_EQ(FolderEntries(out), nothing);
 
+  // The mapper's output folder given for its model (sparse/ for sparse/0): named before colmap
+  // runs, where colmap would abort with a stack trace.
+  const std::string mapper_output = JoinPaths(dir, "mapper_output");
+  WriteReconstruction(model, JoinPaths(mapper_output, "0"), ModelFormat::kText);
+  error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, mapper_output, workspace); });
+  EXPECT_NE(error.find("found a sub-folder 0/"), std::string::npos) << error;
+  EXPECT_EQ(FolderEntries(out), nothing);
+
   error = ErrorOf([&] {
     RunImageUndistorter(ColmapExecutable(), photos, sparse, workspace,
                         [](const std::string&) { HAIRMVS_THROW("the masks failed"); });
