@@ -34,6 +34,9 @@ int PrintHelp() {
 }  // namespace hairmvs
 
 int main(int argc, char** argv) {
+  // Line by line, as stderr's progress is: a log redirected to a file (a cluster job's) keeps
+  // the two in the order they were written.
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
   hairmvs::InitLogging(argv[0]);
   hairmvs::RemoveTemporaryFilesOnInterrupt();
   if (argc < 2) {

@@ -159,6 +159,12 @@ void RemoveTemporariesAndDie(int signal_number) {
     // A name already renamed fails with ENOENT; names are unique to this process.
     if (slot.state.load() == kTracked) unlink(slot.path);
   }
+  // Said rather than leaving the log cut mid-line (write: async-signal-safe).
+  static constexpr char kStopped[] =
+      "\nhairmvs: stopped by a signal; every file written is whole: run the same command again "
+      "to finish (the stereo resumes with --OrientationStereo.skip_existing 1)\n";
+  const ssize_t ignored = write(STDERR_FILENO, kStopped, sizeof(kStopped) - 1);
+  (void)ignored;
   // SA_RESETHAND restored the default action: the signal, delivered again once this handler
   // returns, ends the process as it would have without the handler (exit status, core).
   raise(signal_number);

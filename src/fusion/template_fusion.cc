@@ -268,8 +268,12 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
                       "(the first estimate, unfiltered by the source views' agreement): "
                    << JoinStrings(photometric_only, ", ");
     }
-    THROW_IF(views.empty(), workspace.StereoPath()
-                                << ": no depth map (stereo/depth_maps/<image>.<type>.bin) to fuse");
+    THROW_IF(views.empty(),
+             workspace.StereoPath()
+                 << ": no depth map (stereo/depth_maps/<image>.<type>.bin) to fuse"
+                 << (listed.empty() ? " (stereo/fusion.cfg lists no view)" : "")
+                 << "; compute them first (hairmvs orientation_stereo or patch_match_stereo, or "
+                    "pipeline --stages orientation,stereo)");
   }
 
   const FusionOutput fusion = FuseViews(views, options, timings);
