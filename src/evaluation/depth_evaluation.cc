@@ -248,6 +248,19 @@ std::string DepthEvaluationResult::Table() const {
       views, overall, json_path, TableRow);
 }
 
+namespace {
+
+// The views whose depth maps of options.depth_type are evaluated; an error when there are none.
+std::vector<std::string> DepthMapsToEvaluate(const Workspace& ws,
+                                             const DepthEvaluationOptions& options) {
+  return ViewsToEvaluate(
+      ws, options.image_names,
+      [&](const std::string& name) { return ws.DepthMapPath(name, options.depth_type); },
+      "No " + options.depth_type + " depth maps in " + JoinPaths(ws.StereoPath(), "depth_maps"));
+}
+
+}  // namespace
+
 DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
                                         const std::string& ground_truth_path,
                                         const DepthEvaluationOptions& options,
@@ -255,6 +268,10 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   std::string error;
   THROW_IF(!options.Check(&error), error);
   StageLaps laps(timings);
+  // The maps looked for before the strands are indexed (seconds): a workspace without them
+  // is named at once.
+  DepthMapsToEvaluate(Workspace::Read(workspace_path), options);
+  LOG(INFO) << "Indexing the true strands of " << ground_truth_path;
   const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
   Timer timer;
   const StrandDistance strand_distance(strands, options.strand_spacing_m);
@@ -274,10 +291,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   THROW_IF(!options.Check(&error), error);
   StageLaps laps(timings);
   const Workspace ws = Workspace::Read(workspace_path);
-  const std::vector<std::string> names = ViewsToEvaluate(
-      ws, options.image_names,
-      [&](const std::string& name) { return ws.DepthMapPath(name, options.depth_type); },
-      "No " + options.depth_type + " depth maps in " + JoinPaths(ws.StereoPath(), "depth_maps"));
+  const std::vector<std::string> names = DepthMapsToEvaluate(ws, options);
   const std::string output_path = EvaluationFolder(ws, options.output_path);
 
   const GroundTruthCameras true_cameras =
