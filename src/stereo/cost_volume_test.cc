@@ -125,12 +125,22 @@ TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
   auto context = OpenCLContext::Create();
   const Scene scene = MakeScene(3);
   const DepthLabels labels(0.6, 2.0, 32, true);
-  CostVolumeCL volume(context.get(), StereoCost::kPhotometric, scene.ref, scene.sources,
-                      OrientationTransfer::kNone, 2);
-  const FloatMap got = volume.Compute(scene.base, 0.75f, 5, 3, labels);
-  const FloatMap expected =
-      PhotometricCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 3, labels, 2);
-  EXPECT_LT(MaxAbsDiff(got, expected), 2e-3f);
+  // Window radii 1-3 (3 x 3 to the default 7 x 7), and a second, larger block of slices on the
+  // same volume (its warp buffers grow).
+  for (int radius : {1, 2, 3}) {
+    CostVolumeCL volume(context.get(), StereoCost::kPhotometric, scene.ref, scene.sources,
+                        OrientationTransfer::kNone, radius);
+    EXPECT_LT(MaxAbsDiff(volume.Compute(scene.base, 0.75f, 5, 3, labels),
+                         PhotometricCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 5, 3,
+                                            labels, radius)),
+              2e-3f)
+        << "radius " << radius;
+    EXPECT_LT(MaxAbsDiff(volume.Compute(scene.base, 0.75f, 2, 11, labels),
+                         PhotometricCostCpu(scene.ref, scene.sources, scene.base, 0.75f, 2, 11,
+                                            labels, radius)),
+              2e-3f)
+        << "radius " << radius << ", 11 slices";
+  }
 }
 
 // Between pyramid levels: level 1 (13 x 9) up to level 0 (25 x 18), an output pixel half a
