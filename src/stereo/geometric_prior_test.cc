@@ -82,9 +82,12 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
   // Off the reference's rows and depth, so that grid points do not project onto the sources'
   // pixel borders.
+  // The fourth stands 0.7 m in front of the reference: the labels' points nearer than that lie
+  // behind it.
   std::vector<FusionView> views = {PlaneView(Eigen::Vector3d(-0.1, 0.013, 0.02), 0.1),
                                    PlaneView(Eigen::Vector3d(0.1, 0.05, -0.01), -0.1),
-                                   PlaneView(Eigen::Vector3d(0.3, -0.021, 0.005), 0.0)};
+                                   PlaneView(Eigen::Vector3d(0.3, -0.021, 0.005), 0.0),
+                                   PlaneView(Eigen::Vector3d(0.05, 0.017, 0.7), 0.0)};
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> scale(0.9f, 1.1f), unit(0.0f, 1.0f);
   for (FusionView& view : views) {
