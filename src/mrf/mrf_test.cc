@@ -10,6 +10,7 @@
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
 #include "src/mrf/graph_cuts.h"
+#include "src/mrf/icm_opencl.h"
 #include "src/mrf/mrf_synthetic.h"
 #include "src/mrf/semi_global.h"
 #include "src/opencl/opencl_context.h"
@@ -424,6 +425,45 @@ TEST(MrfSolvers, IcmPolishEndsAtASingleSiteMinimum) {
       }
     }
   }
+}
+
+// The documented tie rules, where every label costs the same: the solvers pick the lowest
+// label, and ICM (on the CPU and on the device) keeps the current one.
+TEST(MrfSolvers, TiesGoToTheLowestLabelAndIcmKeepsTheCurrentOne) {
+  MrfProblem problem;
+  problem.width = 7;
+  problem.height = 5;
+  problem.num_labels = 4;
+  problem.data_cost.assign(problem.NumPixels() * problem.num_labels, 0.5f);
+  for (MrfSolverType type :
+       {MrfSolverType::kSemiGlobal, MrfSolverType::kSemiGlobalCpu,
+        MrfSolverType::kBeliefPropagation, MrfSolverType::kBeliefPropagationCpu,
+        MrfSolverType::kWinnerTakeAll}) {
+    MrfSolverOptions options;
+    options.solver = type;
+    options.icm_polish_iterations = 0;
+    const MrfResult result =
+        SolveMrf(problem, options, UsesOpenCL(type) ? Context().get() : nullptr);
+    EXPECT_EQ(result.labels, std::vector<int>(problem.NumPixels(), 0)) << ToString(type);
+  }
+  std::vector<int> start(problem.NumPixels());
+  for (size_t p = 0; p < start.size(); ++p) start[p] = static_cast<int>((p * 7) % 4);
+  std::vector<int> cpu = start;
+  PolishWithIcm(problem, 10, &cpu);
+  EXPECT_EQ(cpu, start);
+  OpenCLContext* context = Context().get();
+  auto buffer = [&](const std::vector<float>& values) {
+    return cl::Buffer(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                      sizeof(float) * values.size(), const_cast<float*>(values.data()));
+  };
+  const std::vector<float> zeros(problem.NumPixels(), 0.0f);
+  const cl::Buffer cost = buffer(problem.data_cost), offset = buffer(zeros),
+                   weight_right = buffer(zeros), weight_down = buffer(zeros);
+  std::vector<int> device = start;
+  const cl::Buffer labels(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                          sizeof(int) * device.size(), device.data());
+  RunIcmOpenCL(context, cost, offset, weight_right, weight_down, problem, 10, labels);
+  EXPECT_EQ(MrfReadLabels(context->Queue(), labels, device.size()), start);
 }
 
 // The OpenCL belief propagation (with and without the ICM polish on the device) equals its
