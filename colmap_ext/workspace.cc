@@ -319,7 +319,19 @@ cv::Mat ToUnitFloat(const cv::Mat& image, const std::string& path) {
   switch (image.depth()) {
     case CV_8U: image.convertTo(out, CV_32F, 1.0 / 255.0); break;
     case CV_16U: image.convertTo(out, CV_32F, 1.0 / 65535.0); break;
-    case CV_32F: out = image; break;
+    case CV_32F: {
+      // Float pixels are taken as they are: only [0, 1] means what 8 and 16 bits scaled do (a
+      // float TIFF holding 0-255 would read 255 times too bright).
+      double lowest = 0, highest = 0;
+      cv::minMaxLoc(image.reshape(1), &lowest, &highest);
+      THROW_IF(!std::isfinite(lowest) || !std::isfinite(highest) || lowest < 0 ||
+                   highest > 1.0 + 1e-6,
+               "Float image " << path << " holds values from " << lowest << " to " << highest
+                              << ", not in [0, 1]: write it with 8 or 16 bits per channel, or "
+                                 "scaled to [0, 1]");
+      out = image;
+      break;
+    }
     default: HAIRMVS_THROW("Unsupported pixel depth in image " << path);
   }
   return out;

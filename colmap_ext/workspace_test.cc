@@ -169,6 +169,19 @@ TEST(Images, GrayRgbAndSixteenBit) {
   EXPECT_FLOAT_EQ(g16.At(0, 0), 1.0f);
   EXPECT_NEAR(g16.At(1, 0), 32768.0 / 65535.0, 1e-6);
 
+  // Float TIFFs: read as they are in [0, 1]; one holding 0-255 is refused, not read 255 times
+  // too bright.
+  cv::Mat unit(2, 2, CV_32F, cv::Scalar(0.25));
+  const std::string unit_path = JoinPaths(dir, "unit.tif");
+  ASSERT_TRUE(cv::imwrite(unit_path, unit));
+  EXPECT_FLOAT_EQ(ReadImageGray(unit_path).At(1, 1), 0.25f);
+  cv::Mat bytes_as_float(2, 2, CV_32F, cv::Scalar(200));
+  const std::string bytes_path = JoinPaths(dir, "bytes.tif");
+  ASSERT_TRUE(cv::imwrite(bytes_path, bytes_as_float));
+  EXPECT_NE(ErrorOf([&] { ReadImageGray(bytes_path); })
+                .find("bytes.tif holds values from 200 to 200, not in [0, 1]"),
+            std::string::npos);
+
   // WriteImage / ReadImageRgb round trip within 8-bit quantisation.
   FloatMap picture(5, 4, 3);
   for (size_t i = 0; i < picture.Data().size(); ++i) picture.Data()[i] = (i % 11) / 10.0f;
