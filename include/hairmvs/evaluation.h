@@ -65,7 +65,8 @@ struct ImportGroundTruthResult {
 ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
                                           const std::string& workspace_path,
                                           const std::string& output_path,
-                                          const ImportGroundTruthOptions& options);
+                                          const ImportGroundTruthOptions& options,
+                                          StageTimings* timings = nullptr);
 
 struct DepthEvaluationOptions {
   std::string depth_type = "geometric";

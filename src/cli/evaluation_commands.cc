@@ -41,9 +41,10 @@ int RunImportGroundTruth(int argc, char** argv) {
   AddPlain(&parser, &options);
   if (!parser.Parse(argc, argv)) return 0;
   CheckOrThrow(options);
+  StageTimings timings;
   const ImportGroundTruthResult result =
-      ImportGroundTruth(ground_truth_path, workspace_path, output_path, options);
-  std::printf("%s\n", result.Report().c_str());
+      ImportGroundTruth(ground_truth_path, workspace_path, output_path, options, &timings);
+  std::printf("%s\n%s", result.Report().c_str(), RunSummary(timings).c_str());
   return 0;
 }
 

@@ -17,6 +17,7 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
+#include "src/core/timer.h"
 #include "src/evaluation/evaluation_util.h"
 #include "src/evaluation/ground_truth.h"
 
@@ -123,9 +124,11 @@ std::string ImportGroundTruthResult::Report() const {
 ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
                                           const std::string& workspace_path,
                                           const std::string& output_path,
-                                          const ImportGroundTruthOptions& options) {
+                                          const ImportGroundTruthOptions& options,
+                                          StageTimings* timings) {
   std::string error;
   THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
   THROW_IF(output_path.empty(), "Empty --output_path");
   RequireGroundTruthDir(ground_truth_path);  // before anything is written
   THROW_IF(IsSameOrInside(output_path, workspace_path),
@@ -158,6 +161,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   }
   UseTrueCameraPoses(ground_truth_path, names, JoinPaths(output_path, "sparse"));
   const Workspace out_ws = Workspace::Read(output_path);
+  laps.Lap("workspace frame");
 
   ImportGroundTruthResult result;
   result.output_path = output_path;
@@ -169,6 +173,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   for (const std::string& name : names) {
     progress.Start(result.num_views, name);
     const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
+    laps.Lap("read truth");
     const Camera& camera = ws.CameraOf(name);
     THROW_IF(static_cast<int>(camera.width) != view.depth.Width() ||
                  static_cast<int>(camera.height) != view.depth.Height(),
@@ -198,9 +203,11 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
       }
     }
     total += depth.NumPixels();
+    laps.Lap("labels, filter, noise");
     const Eigen::Matrix3d K = camera.CalibrationMatrix();
     WriteMat(out_ws.DepthMapPath(name, "geometric"), depth);
     WriteMat(out_ws.NormalMapPath(name, "geometric"), NormalMapFromDepthMap(depth, K));
+    laps.Lap("normals, write");
     ++result.num_views;
   }
   progress.Finish();

@@ -184,6 +184,12 @@ TEST(Cli, PipelineFromPhotosWithMasksRunsAgain) {
   output = RunHairmvs(run);
   EXPECT_NE(output.exit_code, 0);
   EXPECT_NE(output.text.find("undistort_masks"), std::string::npos) << output.text;
+  // The set's truth as a workspace: its stage table too.
+  output = RunHairmvs("import_ground_truth --ground_truth_path " + JoinPaths(dir, "gt") +
+                      " --workspace_path " + set + " --output_path " + JoinPaths(dir, "truth"));
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  ExpectRunSummary(output.text,
+                   {"workspace frame", "read truth", "labels, filter, noise", "normals, write"});
   std::filesystem::remove_all(dir);
 }
 
