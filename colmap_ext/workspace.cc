@@ -8,7 +8,9 @@
 #include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <sstream>
 
 #include "src/core/file_util.h"
@@ -17,6 +19,30 @@
 namespace fs = std::filesystem;
 
 namespace hairmvs {
+
+namespace {
+
+// The width and height a PNG's header states (its IHDR chunk), without decoding it; false for a
+// file that is no PNG or too short to say.
+bool PngSize(const std::string& path, int* width, int* height) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[24];
+  if (!in.read(reinterpret_cast<char*>(header), sizeof(header))) return false;
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (std::memcmp(header, kSignature, 8) != 0 || std::memcmp(header + 12, "IHDR", 4) != 0) {
+    return false;
+  }
+  auto big_endian = [&header](int at) {
+    return static_cast<int>((static_cast<uint32_t>(header[at]) << 24) |
+                            (static_cast<uint32_t>(header[at + 1]) << 16) |
+                            (static_cast<uint32_t>(header[at + 2]) << 8) | header[at + 3]);
+  };
+  *width = big_endian(16);
+  *height = big_endian(20);
+  return true;
+}
+
+}  // namespace
 
 Workspace Workspace::Read(const std::string& path, const std::string& mask_path) {
   THROW_IF(path.empty(), "Empty workspace path (--workspace_path)");
@@ -85,6 +111,33 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
                  << ws.image_names_.size() << " images (" << names.str() << "; expected "
                  << JoinPaths(ws.mask_path_, "<image name>.png")
                  << "): they are processed without a mask";
+  }
+  // A mask a few percent off its image's size is likely drawn on the photo: the undistorter
+  // shrinks or grows both sides of a photo alike for radial distortion, so ReadMask takes such a
+  // mask for a scaled copy, misplaced by pixels towards the edges. Said, not refused: a mask
+  // resized on purpose is read as one. (The header alone: PNG masks, as COLMAP names them.)
+  std::vector<std::string> near_size;
+  for (const std::string& name : ws.image_names_) {
+    const std::string mask = ws.MaskPath(name);
+    int width = 0, height = 0;
+    if (mask.empty() || !PngSize(mask, &width, &height)) continue;
+    const Camera& camera = ws.model_.cameras.at(ws.ImageByName(name).camera_id);
+    const double scale = static_cast<double>(width) / camera.width;
+    if ((width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height)) &&
+        scale > 0.9 && scale < 1.1) {
+      std::ostringstream line;
+      line << name << " (" << width << " x " << height << " for " << camera.width << " x "
+           << camera.height << ")";
+      near_size.push_back(line.str());
+    }
+  }
+  if (!near_size.empty()) {
+    LOG(WARNING) << ws.mask_path_ << ": " << near_size.size() << " mask(s) a few percent off "
+                 << "their image's size, " << near_size.front()
+                 << (near_size.size() > 1 ? ", ..." : "")
+                 << ": drawn on the photos before colmap image_undistorter? They are read as "
+                    "scaled copies, which such masks are not (hairmvs undistort_masks undistorts "
+                    "masks drawn on the photos)";
   }
   return ws;
 }

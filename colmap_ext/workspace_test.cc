@@ -88,6 +88,28 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   EXPECT_NE(stem_error.find(JoinPaths(stems, "a.png.png")), std::string::npos) << stem_error;
 }
 
+// A mask a few percent off its image's size (drawn on the photo before the undistorter) is
+// warned about; one of the same size or a scaled copy (twice the size) is not.
+TEST(Workspace, MasksAFewPercentOffTheImageSizeAreWarnedAbout) {
+  const std::string dir = MakeTestDir("ws_mask_sizes");
+  WriteTestWorkspace(dir, MakePlaneModel());  // 64 x 48 images
+  CreateDirs(JoinPaths(dir, "masks"));
+  cv::imwrite(JoinPaths(dir, "masks", "a.png.png"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
+  cv::imwrite(JoinPaths(dir, "masks", "b.png.png"), cv::Mat(96, 128, CV_8U, cv::Scalar(255)));
+  cv::imwrite(JoinPaths(dir, "masks", "c.png.png"), cv::Mat(48, 64, CV_8U, cv::Scalar(255)));
+  ::testing::internal::CaptureStderr();
+  Workspace::Read(dir);
+  std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("a few percent off"), std::string::npos) << log;
+  cv::imwrite(JoinPaths(dir, "masks", "c.png.png"), cv::Mat(49, 66, CV_8U, cv::Scalar(255)));
+  ::testing::internal::CaptureStderr();
+  Workspace::Read(dir);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("1 mask(s) a few percent off their image's size, c.png (66 x 49 for 64 x 48)"),
+            std::string::npos)
+      << log;
+}
+
 TEST(Workspace, BadWorkspaces) {
   const std::string dir = MakeTestDir("ws_bad");
   // Missing folder, missing sparse model.
