@@ -5,7 +5,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -78,8 +77,7 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
     // a choice to match the whole scene.
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(ws.mask_path_, ec)) {
-      std::string extension = entry.path().extension().string();
-      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const std::string extension = ToLower(entry.path().extension().string());
       if (!entry.is_regular_file(ec) || entry.path().filename().string()[0] == '.' ||
           (extension != ".png" && extension != ".jpg" && extension != ".jpeg" &&
            extension != ".bmp" && extension != ".tif" && extension != ".tiff")) {

@@ -2,7 +2,6 @@
 // hairmvs patch_match_stereo: the same, behind colmap patch_match_stereo's command line.
 
 #include <algorithm>
-#include <cctype>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -141,9 +140,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   parser.AddIgnored("log_level", "hairmvs logs warnings and errors always");
   if (!parser.Parse(argc, argv)) return 0;
   // Any case, as colmap takes it.
-  std::string format = workspace_format;
-  for (char& c : format) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  THROW_IF(format != "COLMAP",
+  THROW_IF(ToLower(workspace_format) != "colmap",
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
   if (parser.WasGiven("config_path")) source_options.config_path = config_path;
   // colmap's options and the fields they set: applied where given, and named in the error

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -95,6 +96,12 @@ std::string StripWhitespace(const std::string& s) {
   if (begin == std::string::npos) return "";
   const size_t end = s.find_last_not_of(ws);
   return s.substr(begin, end - begin + 1);
+}
+
+std::string ToLower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s;
 }
 
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims) {

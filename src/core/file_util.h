@@ -31,6 +31,8 @@ std::string ParentPath(const std::string& path);
 std::string ReadTextFile(const std::string& path);
 std::vector<std::string> ReadLines(const std::string& path);
 std::string StripWhitespace(const std::string& s);
+// `s` with its ASCII letters in lower case (option values and file extensions in any case).
+std::string ToLower(std::string s);
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims);
 // The parts with `separator` between them: "a, b" from {"a", "b"} and ", ".
 std::string JoinStrings(const std::vector<std::string>& parts, const std::string& separator);

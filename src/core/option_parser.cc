@@ -1,7 +1,6 @@
 #include "src/core/option_parser.h"
 
 #include <boost/program_options.hpp>
-#include <cctype>
 #include <cmath>
 #include <iostream>
 #include <map>
@@ -103,8 +102,7 @@ void OptionParser::Add(const std::string& name, bool* value, const std::string& 
       name, *value ? "1" : "0", help, required,
       [value](const std::string& given) {
         // Any case, as colmap's parser takes them ("True", "YES").
-        std::string text = given;
-        for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+        const std::string text = ToLower(given);
         if (text == "1" || text == "true" || text == "on" || text == "yes") *value = true;
         else if (text == "0" || text == "false" || text == "off" || text == "no") *value = false;
         else return false;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <limits>
-#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -17,12 +16,6 @@
 
 namespace hairmvs {
 namespace {
-
-std::string ToLower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s;
-}
 
 std::string DeviceTypeName(cl_device_type type) {
   if (type & CL_DEVICE_TYPE_GPU) return "GPU";
