@@ -181,20 +181,23 @@ void RemoveTemporariesAndDie(int signal_number) {
 // process only within both. Containers on one host may share its name but each have a PID
 // namespace of their own, with the same pids, so a run looks up the processes of the files of
 // its own host and namespace only.
-std::string HostTag() {
-  char name[256] = {};
-  std::string tag = gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0' ? name
-                                                                               : "localhost";
-  char link[64] = {};  // "pid:[4026531836]"
-  const ssize_t length = readlink("/proc/self/ns/pid", link, sizeof(link) - 1);
-  if (length > 0) {
-    const std::string text(link, static_cast<size_t>(length));
-    const size_t open = text.find('['), close = text.find(']');
-    if (open != std::string::npos && close != std::string::npos && close > open + 1) {
-      tag += "~" + text.substr(open + 1, close - open - 1);
+const std::string& HostTag() {
+  static const std::string host_tag = [] {  // the same for the process's life
+    char name[256] = {};
+    std::string tag =
+        gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0' ? name : "localhost";
+    char link[64] = {};  // "pid:[4026531836]"
+    const ssize_t length = readlink("/proc/self/ns/pid", link, sizeof(link) - 1);
+    if (length > 0) {
+      const std::string text(link, static_cast<size_t>(length));
+      const size_t open = text.find('['), close = text.find(']');
+      if (open != std::string::npos && close != std::string::npos && close > open + 1) {
+        tag += "~" + text.substr(open + 1, close - open - 1);
+      }
     }
-  }
-  return tag;
+    return tag;
+  }();
+  return host_tag;
 }
 
 // Eight hex digits drawn once per process: with the pid and the host tag, a temporary's name is
