@@ -169,9 +169,10 @@ int RunPipeline(int argc, char** argv) {
         &source_options, &orientation_options);
     std::printf("%s\n", result.BriefReport().c_str());
   }
-  bool fused = false;  // whether meshed-hair.ply is this run's
+  // Whether meshed-hair.ply is this run's: the fusion stage runs on every view only.
+  const bool fused = HasStage(stages, "fusion") && image_names.empty();
   if (HasStage(stages, "fusion")) {
-    if (!image_names.empty()) {
+    if (!fused) {
       std::fprintf(stderr,
                    "[pipeline] --image_names given: skipping fusion (run `hairmvs "
                    "template_fusion --workspace_path %s` once every view is done)\n",
@@ -181,7 +182,6 @@ int RunPipeline(int argc, char** argv) {
       const TemplateFusionResult result =
           RunTemplateFusion(workspace_path, fusion_options, &timings);
       std::printf("%s\n", result.BriefReport().c_str());
-      fused = true;
     }
   }
 
@@ -246,7 +246,7 @@ int RunPipeline(int argc, char** argv) {
   if (!ground_truth_path.empty()) {
     std::printf("  %s/stereo/evaluation/*.png   error pictures\n", w);
   }
-  if (HasStage(stages, "fusion") && image_names.empty()) {
+  if (fused) {
     std::printf("  %s/fused.ply, %s/meshed-hair.ply   the fused points and the hair surface "
                 "(MeshLab; COLMAP's GUI shows fused.ply, with File > Import From, over "
                 "sparse/)\n",
