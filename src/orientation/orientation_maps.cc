@@ -212,8 +212,6 @@ void WriteOrientationFields(const Workspace& workspace, const std::string& name,
     SplitProvenanceFile(ReadTextFile(provenance_path), &old_inputs, &old_fingerprints);
   }
   std::error_code error;
-  std::filesystem::remove(provenance_path, error);
-  THROW_IF(error, "Cannot remove " << provenance_path << ": " << error.message());
   // Each level's fingerprint is of the bytes this run writes, not of the file after it (which
   // another run may have replaced already).
   std::vector<std::string> data(levels.size()), fingerprints(levels.size());
@@ -233,16 +231,21 @@ void WriteOrientationFields(const Workspace& workspace, const std::string& name,
     std::filesystem::remove(picture, error);
     THROW_IF(error, "Cannot remove " << picture << ": " << error.message());
   }
+  // The levels and then their provenance as one unit, the provenance marking it whole: it is
+  // removed before any level is replaced and written last, so that levels left half-replaced
+  // by an interrupted run are never reused.
   std::string recorded = provenance;
+  std::vector<FileToWrite> files;
   for (size_t l = 0; l < levels.size(); ++l) {
-    WriteFileAtomically(workspace.OrientationMapPath(name, static_cast<int>(l)),
-                        [&](std::ostream& out) {
-                          out.write(data[l].data(), static_cast<std::streamsize>(data[l].size()));
-                        });
+    files.push_back({workspace.OrientationMapPath(name, static_cast<int>(l)),
+                     [&data, l](std::ostream& out) {
+                       out.write(data[l].data(), static_cast<std::streamsize>(data[l].size()));
+                     }});
     recorded += LevelLine(static_cast<int>(l), fingerprints[l]) + "\n";
   }
-  WriteFileAtomically(provenance_path, [&](std::ostream& out) { out << recorded; },
-                      /*binary=*/false);
+  files.push_back({provenance_path, [&recorded](std::ostream& out) { out << recorded; },
+                   /*binary=*/false});
+  WriteFilesAtomically(files, /*last_marks_complete=*/true);
 }
 
 }  // namespace hairmvs

@@ -43,8 +43,9 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
     const StereoCamera& camera, int num_levels, std::string* why_not);
 
-// Writes the levels of `name`, then its provenance. The old provenance file is removed first,
-// so that levels left half-replaced by an interrupted run are never reused.
+// Writes the levels of `name`, then its provenance, as one unit (WriteFilesAtomically with the
+// provenance marking it whole): the old provenance is removed before any level is replaced, so
+// that levels left half-replaced by an interrupted run are never reused.
 void WriteOrientationFields(const Workspace& workspace, const std::string& name,
                             const std::string& provenance, const std::vector<FloatMap>& levels);
 
