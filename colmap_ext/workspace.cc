@@ -71,30 +71,52 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
   } else if (ExistsDir(JoinPaths(path, "masks"))) {
     ws.mask_path_ = JoinPaths(path, "masks");
   }
-  const std::vector<std::string> unmasked = ws.ImagesWithoutMask();
+  // Each image's mask looked up once: those without one, and those a few percent off their
+  // image's size, which is likely drawn on the photo: the undistorter shrinks or grows both
+  // sides of a photo alike for radial distortion, so ReadMask takes such a mask for a scaled
+  // copy, misplaced by pixels towards the edges. Said, not refused: a mask resized on purpose
+  // is read as one. (The header alone: PNG masks, as COLMAP names them.)
+  std::vector<std::string> unmasked, near_size;
+  for (const std::string& name : ws.image_names_) {
+    if (ws.mask_path_.empty()) break;
+    const std::string mask = ws.MaskPath(name);
+    int width = 0, height = 0;
+    if (mask.empty()) {
+      unmasked.push_back(name);
+    } else if (PngSize(mask, &width, &height)) {
+      const Camera& camera = ws.model_.cameras.at(ws.ImageByName(name).camera_id);
+      const double scale = static_cast<double>(width) / camera.width;
+      if ((width != static_cast<int>(camera.width) ||
+           height != static_cast<int>(camera.height)) &&
+          scale > 0.9 && scale < 1.1) {
+        std::ostringstream line;
+        line << name << " (" << width << " x " << height << " for " << camera.width << " x "
+             << camera.height << ")";
+        near_size.push_back(line.str());
+      }
+    }
+  }
   if (!unmasked.empty() && unmasked.size() == ws.image_names_.size()) {
     // Files there, but none named for an image: a naming mistake (the image's stem, say), not
-    // a choice to match the whole scene.
+    // a choice to match the whole scene. And a folder given for the masks that holds none is a
+    // wrong folder; the workspace's own masks/ left empty is taken as no masks (warned about
+    // below).
+    std::string holds = "no image file";
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(ws.mask_path_, ec)) {
       const std::string extension = ToLower(entry.path().extension().string());
-      if (!entry.is_regular_file(ec) || entry.path().filename().string()[0] == '.' ||
-          (extension != ".png" && extension != ".jpg" && extension != ".jpeg" &&
-           extension != ".bmp" && extension != ".tif" && extension != ".tiff")) {
-        continue;
+      if (entry.is_regular_file(ec) && entry.path().filename().string()[0] != '.' &&
+          (extension == ".png" || extension == ".jpg" || extension == ".jpeg" ||
+           extension == ".bmp" || extension == ".tif" || extension == ".tiff")) {
+        holds = entry.path().filename().string();
+        break;
       }
-      HAIRMVS_THROW("No mask in " << ws.mask_path_ << " belongs to an image of the workspace: "
-                                  << "it holds " << entry.path().filename().string()
-                                  << ", but the mask of the image " << ws.image_names_.front()
-                                  << " is " << JoinPaths(ws.mask_path_,
-                                                         ws.image_names_.front() + ".png")
-                                  << " (COLMAP's naming: <image name>.png)");
     }
-    // A folder given for the masks that holds none is a wrong folder; the workspace's own
-    // masks/ left empty is taken as no masks (warned about below).
-    THROW_IF(!mask_path.empty(),
-             "No mask in " << ws.mask_path_ << " (the mask folder given) belongs to an image of "
-                           << "the workspace: it holds no image file; the mask of the image "
+    const bool holds_images = holds != "no image file";
+    THROW_IF(holds_images || !mask_path.empty(),
+             "No mask in " << ws.mask_path_ << (holds_images ? "" : " (the mask folder given)")
+                           << " belongs to an image of the workspace: it holds " << holds
+                           << (holds_images ? ", but" : ";") << " the mask of the image "
                            << ws.image_names_.front() << " is "
                            << JoinPaths(ws.mask_path_, ws.image_names_.front() + ".png")
                            << " (COLMAP's naming: <image name>.png)");
@@ -109,25 +131,6 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
                  << ws.image_names_.size() << " images (" << names.str() << "; expected "
                  << JoinPaths(ws.mask_path_, "<image name>.png")
                  << "): they are processed without a mask";
-  }
-  // A mask a few percent off its image's size is likely drawn on the photo: the undistorter
-  // shrinks or grows both sides of a photo alike for radial distortion, so ReadMask takes such a
-  // mask for a scaled copy, misplaced by pixels towards the edges. Said, not refused: a mask
-  // resized on purpose is read as one. (The header alone: PNG masks, as COLMAP names them.)
-  std::vector<std::string> near_size;
-  for (const std::string& name : ws.image_names_) {
-    const std::string mask = ws.MaskPath(name);
-    int width = 0, height = 0;
-    if (mask.empty() || !PngSize(mask, &width, &height)) continue;
-    const Camera& camera = ws.model_.cameras.at(ws.ImageByName(name).camera_id);
-    const double scale = static_cast<double>(width) / camera.width;
-    if ((width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height)) &&
-        scale > 0.9 && scale < 1.1) {
-      std::ostringstream line;
-      line << name << " (" << width << " x " << height << " for " << camera.width << " x "
-           << camera.height << ")";
-      near_size.push_back(line.str());
-    }
   }
   if (!near_size.empty()) {
     LOG(WARNING) << ws.mask_path_ << ": " << near_size.size() << " mask(s) a few percent off "
