@@ -220,18 +220,20 @@ FloatMap ResizeArea(const FloatMap& input, int width, int height) {
 
 }  // namespace
 
-FloatMap Workspace::ReadViewGray(const std::string& name, int max_image_size) const {
-  FloatMap image = RequireCameraSize(name, ReadImageGray(ImagePath(name)));
+FloatMap Workspace::AtMaxImageSize(const std::string& name, FloatMap image,
+                                   int max_image_size) const {
+  image = RequireCameraSize(name, std::move(image));
   if (max_image_size <= 0) return image;
   const StereoCamera camera = ViewCamera(name).AtMaxImageSize(max_image_size);
   return ResizeArea(image, camera.width, camera.height);
 }
 
+FloatMap Workspace::ReadViewGray(const std::string& name, int max_image_size) const {
+  return AtMaxImageSize(name, ReadImageGray(ImagePath(name)), max_image_size);
+}
+
 FloatMap Workspace::ReadViewRgb(const std::string& name, int max_image_size) const {
-  FloatMap image = RequireCameraSize(name, ReadImageRgb(ImagePath(name)));
-  if (max_image_size <= 0) return image;
-  const StereoCamera camera = ViewCamera(name).AtMaxImageSize(max_image_size);
-  return ResizeArea(image, camera.width, camera.height);
+  return AtMaxImageSize(name, ReadImageRgb(ImagePath(name)), max_image_size);
 }
 
 std::string Workspace::ImagePath(const std::string& name) const {

@@ -72,6 +72,9 @@ class Workspace {
  private:
   // `image` (read from ImagePath(name)), or throws naming it unless it has its camera's size.
   FloatMap RequireCameraSize(const std::string& name, FloatMap image) const;
+  // `image` checked by RequireCameraSize, then area-resized to the processing size of
+  // max_image_size (> 0; as it is otherwise).
+  FloatMap AtMaxImageSize(const std::string& name, FloatMap image, int max_image_size) const;
 
   std::string path_;
   std::string mask_path_;
