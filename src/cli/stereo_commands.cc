@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -144,51 +145,48 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
   if (parser.WasGiven("config_path")) source_options.config_path = config_path;
   // colmap's options and the fields they set: applied where given, and named in the error
-  // when a value they set is refused.
+  // when a value they set is refused. `colmap_default`: colmap's default where hairmvs's own
+  // differs on purpose (OrientationStereoOptions says why), NaN elsewhere.
   struct MappedOption {
     const char* colmap_name;
     const char* section;  // of the hairmvs option it sets: <section>.<field>
     const char* field;
+    double value;  // as given
+    double colmap_default;
     std::function<void()> apply;
   };
+  constexpr double kSame = std::numeric_limits<double>::quiet_NaN();
   const std::vector<MappedOption> mapped = {
       {"PatchMatchStereo.max_image_size", "OrientationStereo", "max_image_size",
+       static_cast<double>(max_image_size), kSame,
        [&] { options.max_image_size = max_image_size; }},
-      {"PatchMatchStereo.depth_min", "OrientationStereo", "depth_min",
+      {"PatchMatchStereo.depth_min", "OrientationStereo", "depth_min", depth_min, kSame,
        [&] { options.depth_min = depth_min; }},
-      {"PatchMatchStereo.depth_max", "OrientationStereo", "depth_max",
+      {"PatchMatchStereo.depth_max", "OrientationStereo", "depth_max", depth_max, kSame,
        [&] { options.depth_max = depth_max; }},
       {"PatchMatchStereo.min_triangulation_angle", "SourceViews", "min_triangulation_angle_deg",
+       min_triangulation_angle, kSame,
        [&] { source_options.min_triangulation_angle_deg = min_triangulation_angle; }},
       {"PatchMatchStereo.geom_consistency", "OrientationStereo", "geom_consistency",
+       static_cast<double>(geom_consistency), kSame,
        [&] { options.geom_consistency = geom_consistency; }},
       {"PatchMatchStereo.geom_consistency_max_cost", "OrientationStereo",
-       "geom_prior_max_error_px",
+       "geom_prior_max_error_px", geom_consistency_max_cost, 3,
        [&] { options.geom_prior_max_error_px = geom_consistency_max_cost; }},
       {"PatchMatchStereo.filter_min_num_consistent", "OrientationStereo",
-       "geom_consistency_min_views",
+       "geom_consistency_min_views", static_cast<double>(filter_min_num_consistent), 2,
        [&] { options.geom_consistency_min_views = filter_min_num_consistent; }},
       {"PatchMatchStereo.filter_geom_consistency_max_cost", "OrientationStereo",
-       "geom_consistency_max_error_px",
+       "geom_consistency_max_error_px", filter_geom_consistency_max_cost, 1,
        [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
   };
   // A project file that colmap wrote lists every option, most at colmap's defaults: where
-  // hairmvs's differ on purpose (OrientationStereoOptions says why), colmap's from the file are
-  // left to them; given on the command line they apply.
-  struct ColmapDefault {
-    const char* name;
-    double colmap_default;
-    double value;
-  };
-  const ColmapDefault colmap_defaults[] = {
-      {"PatchMatchStereo.filter_min_num_consistent", 2,
-       static_cast<double>(filter_min_num_consistent)},
-      {"PatchMatchStereo.filter_geom_consistency_max_cost", 1, filter_geom_consistency_max_cost},
-      {"PatchMatchStereo.geom_consistency_max_cost", 3, geom_consistency_max_cost}};
+  // hairmvs's differ on purpose, colmap's from the file are left to them; given on the command
+  // line they apply.
   std::vector<std::string> left_to_hairmvs;
-  for (const ColmapDefault& option : colmap_defaults) {
-    if (parser.FromProjectFile(option.name) && option.value == option.colmap_default) {
-      left_to_hairmvs.push_back(option.name);
+  for (const MappedOption& option : mapped) {
+    if (parser.FromProjectFile(option.colmap_name) && option.value == option.colmap_default) {
+      left_to_hairmvs.push_back(option.colmap_name);
     }
   }
   if (!left_to_hairmvs.empty()) {
