@@ -275,6 +275,14 @@ void ValidateCamera(const Camera& camera, const std::string& where) {
   }
 }
 
+// A pose the dense stage can use: a translation of finite numbers (the quaternion is checked
+// by NormalizedQuaternion). `where` names the file and the image (binary) or the line (text).
+void ValidateTranslation(const Eigen::Vector3d& translation, const std::string& where) {
+  THROW_IF(!translation.allFinite(), where << ": translation (" << translation.x() << ", "
+                                           << translation.y() << ", " << translation.z()
+                                           << ") is not finite");
+}
+
 // Image names are unique in a model (COLMAP requires it; maps are named after images).
 // `names` maps the names read so far to their image ids.
 void RequireUniqueName(const Image& image, const std::string& where,
@@ -337,6 +345,7 @@ void ReadImagesBinary(std::istream& in, const std::string& source, Reconstructio
     for (int k = 0; k < 3; ++k) {
       image.cam_from_world_translation[k] = ReadBinary<double>(in, source, "image translation");
     }
+    ValidateTranslation(image.cam_from_world_translation, where.str());
     image.camera_id = ReadBinary<uint32_t>(in, source, "image camera_id");
     // NUL-terminated name.
     std::string name;
@@ -448,6 +457,7 @@ void ReadImagesText(std::istream& in, const std::string& source, Reconstruction*
     for (int k = 0; k < 3; ++k) {
       image.cam_from_world_translation[k] = ParseDouble(tokens[5 + k], where, "translation");
     }
+    ValidateTranslation(image.cam_from_world_translation, where);
     image.camera_id = ParseInteger<uint32_t>(tokens[8], where, "CAMERA_ID");
     image.name = tokens[9];
     // The second line (POINTS2D) is required, even when empty.
@@ -750,6 +760,9 @@ Reconstruction ReadReconstruction(const std::string& dir) {
              images_file << ": image " << id << " (" << image.name << ") refers to camera "
                          << image.camera_id << ", which is not in the cameras file");
   }
+  const std::string implausible =
+      DescribeImplausibleCameras(r, JoinPaths(dir, "cameras" + extension));
+  if (!implausible.empty()) LOG(WARNING) << implausible;
   const std::string inconsistencies =
       DescribeTrackInconsistencies(r, JoinPaths(dir, "points3D" + extension), images_file);
   if (!inconsistencies.empty()) {
@@ -759,6 +772,42 @@ Reconstruction ReadReconstruction(const std::string& dir) {
   }
   return r;
 }
+
+std::string DescribeImplausibleCameras(const Reconstruction& r, const std::string& cameras_file) {
+  std::ostringstream out;
+  size_t num_implausible = 0;
+  for (const auto& [id, camera] : r.cameras) {
+    const CameraModelInfo& info = CameraModelById(camera.model_id);
+    if (info.num_focal_params == 0) continue;  // no focal length or principal point
+    std::vector<std::string> problems;
+    const double max_size = static_cast<double>(std::max(camera.width, camera.height));
+    for (int k = 0; k < info.num_focal_params; ++k) {
+      const double ratio = camera.params[k] / max_size;
+      if (ratio < 0.1 || ratio > 10) {
+        std::ostringstream problem;
+        problem << CameraParamName(info, k) << " " << camera.params[k] << " is " << ratio
+                << " times the larger side";
+        problems.push_back(problem.str());
+      }
+    }
+    const double cx = camera.params[info.num_focal_params];
+    const double cy = camera.params[info.num_focal_params + 1];
+    if (cx < 0 || cx > static_cast<double>(camera.width) || cy < 0 ||
+        cy > static_cast<double>(camera.height)) {
+      std::ostringstream problem;
+      problem << "the principal point (" << cx << ", " << cy << ") lies outside the image";
+      problems.push_back(problem.str());
+    }
+    if (problems.empty()) continue;
+    out << (num_implausible++ == 0 ? "" : "; ") << "camera " << id << " (" << info.name << ", "
+        << camera.width << " x " << camera.height << " px): " << JoinStrings(problems, ", ");
+  }
+  if (num_implausible == 0) return "";
+  return cameras_file + ": " + out.str() +
+         ". COLMAP's mapper discards such calibrations (focal length 0.1-10 times the larger "
+         "side, principal point inside the image); depth maps from them come out empty or wrong.";
+}
+
 
 std::string DescribeTrackInconsistencies(const Reconstruction& reconstruction,
                                          const std::string& points_file,

@@ -117,10 +117,20 @@ enum class ModelFormat { kBinary, kText };
 // naming the file (and the line, for text) and the problem (missing files, truncated, trailing
 // bytes, unknown model id, wrong parameter count, malformed line, a camera size outside
 // [1, kMaxCameraSizePx], a parameter that is nan or inf, a focal length that is not > 0, two
-// images with the same name).
+// images with the same name, a translation that is nan or inf).
 // A model whose tracks and keypoints disagree still reads (source views and depth ranges pass
-// over what does not resolve), with a warning that DescribeTrackInconsistencies words.
+// over what does not resolve), with a warning that DescribeTrackInconsistencies words; so does
+// a model with an implausible calibration, with DescribeImplausibleCameras's warning.
 Reconstruction ReadReconstruction(const std::string& dir);
+
+// COLMAP's own test of a calibration that cannot be right (Camera::HasBogusParams with the
+// mapper's defaults, min_focal_length_ratio 0.1 and max_focal_length_ratio 10): a focal length
+// outside 0.1-10 times the larger image side, a principal point outside the image. COLMAP's
+// dense code takes such a camera as it is, and so does hairmvs, but its depth maps come out
+// empty or wrong with no other sign; so the warning names each camera and what is wrong with
+// it. Empty when every camera passes. `cameras_file` is where they were read from.
+std::string DescribeImplausibleCameras(const Reconstruction& reconstruction,
+                                       const std::string& cameras_file);
 
 // What of the model's sparse points does not resolve, one sentence per kind (empty when
 // everything does): track elements naming an image that is not in the model or a keypoint

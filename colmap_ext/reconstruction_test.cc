@@ -5,6 +5,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <set>
 #include <sstream>
@@ -625,6 +626,67 @@ TEST(Reconstruction, NonFiniteCameraParametersAndBadFocalLengthsAreRefused) {
         << info.name << ": " << message;
     EXPECT_NE(message.find("is nan"), std::string::npos) << info.name << ": " << message;
   }
+}
+
+// A translation of nan or inf makes every depth map of that view empty and every source view
+// of it useless; it is refused, naming the image (binary) or the line (text).
+TEST(Reconstruction, NonFiniteTranslationIsRefused) {
+  const Reconstruction model = MakePlaneModel();
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    Reconstruction r = model;
+    r.images.at(2).cam_from_world_translation.z() = bad;
+    std::stringstream bytes;
+    WriteImagesBinary(r, bytes);
+    Reconstruction read = model;
+    read.images.clear();
+    const std::string message =
+        testing_util::ErrorOf([&] { ReadImagesBinary(bytes, "images.bin", &read); });
+    EXPECT_NE(message.find("images.bin: image 2: translation ("), std::string::npos) << message;
+    EXPECT_NE(message.find("is not finite"), std::string::npos) << message;
+  }
+  std::string text;
+  const std::string message =
+      ErrorOfEditedTextModel("translation_nan", model, "images.txt", [&](std::string* t) {
+        const size_t line = t->find("\n2 ");
+        ASSERT_NE(line, std::string::npos);
+        // IMAGE_ID QW QX QY QZ TX TY TZ: the 8th token becomes nan.
+        size_t pos = line + 1;
+        for (int k = 0; k < 7; ++k) pos = t->find(' ', pos) + 1;
+        t->replace(pos, t->find(' ', pos) - pos, "nan");
+        text = *t;
+      });
+  const int line = LineStartingWith(text, "2 ");
+  EXPECT_NE(message.find("images.txt:" + std::to_string(line) + ": translation ("),
+            std::string::npos)
+      << message;
+  EXPECT_NE(message.find(", nan) is not finite"), std::string::npos) << message;
+}
+
+// COLMAP's mapper's test of a calibration (HasBogusParams): each camera outside it is named
+// with what is wrong; a model that passes gets no warning (and still reads either way).
+TEST(Reconstruction, ImplausibleCalibrationsAreNamed) {
+  Reconstruction model = MakePlaneModel();  // "1 PINHOLE 64 48 50 50 32 24"
+  EXPECT_EQ(DescribeImplausibleCameras(model, "cameras.bin"), "");
+  // The limits themselves pass: focal 0.1 and 10 times 64 px, the principal point on the edge.
+  model.cameras.at(1).params = {6.4, 640, 64, 0};
+  EXPECT_EQ(DescribeImplausibleCameras(model, "cameras.bin"), "");
+  model.cameras.at(1).params = {6.3, 50, 32, 48.5};
+  Camera second = model.cameras.at(1);
+  second.camera_id = 7;
+  second.model_id = CameraModelByName("SIMPLE_RADIAL").id;
+  second.params = {50, 1e30, 24, 0.01};
+  model.cameras[7] = second;
+  const std::string message = DescribeImplausibleCameras(model, "sparse/cameras.bin");
+  for (const std::string part :
+       {"sparse/cameras.bin: camera 1 (PINHOLE, 64 x 48 px): fx 6.3 is 0.0984375 times the "
+        "larger side, the principal point (32, 48.5) lies outside the image; camera 7 "
+        "(SIMPLE_RADIAL, 64 x 48 px): the principal point (1e+30, 24) lies outside the image.",
+        "depth maps from them come out empty or wrong"}) {
+    EXPECT_NE(message.find(part), std::string::npos) << "'" << part << "' not in: " << message;
+  }
+  const std::string dir = MakeTestDir("implausible_calibration");
+  WriteReconstruction(model, dir, ModelFormat::kBinary);
+  ExpectModelsEqual(model, ReadReconstruction(dir));
 }
 
 TEST(CameraModels, FocalLengthsAndParameterNames) {
