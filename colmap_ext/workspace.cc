@@ -191,18 +191,23 @@ void Workspace::RequireUndistortedCameras() const {
   for (const std::string& name : image_names_) CameraOf(name);
 }
 
-FloatMap Workspace::RequireCameraSize(const std::string& name, FloatMap image) const {
+void Workspace::RequireCameraSize(const std::string& name, int width, int height) const {
   const std::string path = ImagePath(name);
   const Camera& camera = model_.cameras.at(ImageByName(name).camera_id);
-  THROW_IF(image.Width() != static_cast<int>(camera.width) ||
-               image.Height() != static_cast<int>(camera.height),
-           "Image " << path << " is " << image.Width() << " x " << image.Height()
+  THROW_IF(width != static_cast<int>(camera.width) || height != static_cast<int>(camera.height),
+           "Image " << path << " is " << width << " x " << height
                     << " but its camera " << camera.camera_id << " is " << camera.width << " x "
                     << camera.height
                     << ": images/ must be as colmap image_undistorter wrote them (the stereo's "
                        "--OrientationStereo.max_image_size works at a lower resolution without "
                        "resizing them)");
-  return image;
+}
+
+std::string Workspace::ImagePathOfCameraSize(const std::string& name) const {
+  const std::string path = ImagePath(name);
+  int width = 0, height = 0;
+  if (PngSize(path, &width, &height)) RequireCameraSize(name, width, height);
+  return path;
 }
 
 namespace {
@@ -222,18 +227,18 @@ FloatMap ResizeArea(const FloatMap& input, int width, int height) {
 
 FloatMap Workspace::AtMaxImageSize(const std::string& name, FloatMap image,
                                    int max_image_size) const {
-  image = RequireCameraSize(name, std::move(image));
+  RequireCameraSize(name, image.Width(), image.Height());
   if (max_image_size <= 0) return image;
   const StereoCamera camera = ViewCamera(name).AtMaxImageSize(max_image_size);
   return ResizeArea(image, camera.width, camera.height);
 }
 
 FloatMap Workspace::ReadViewGray(const std::string& name, int max_image_size) const {
-  return AtMaxImageSize(name, ReadImageGray(ImagePath(name)), max_image_size);
+  return AtMaxImageSize(name, ReadImageGray(ImagePathOfCameraSize(name)), max_image_size);
 }
 
 FloatMap Workspace::ReadViewRgb(const std::string& name, int max_image_size) const {
-  return AtMaxImageSize(name, ReadImageRgb(ImagePath(name)), max_image_size);
+  return AtMaxImageSize(name, ReadImageRgb(ImagePathOfCameraSize(name)), max_image_size);
 }
 
 std::string Workspace::ImagePath(const std::string& name) const {
@@ -354,9 +359,14 @@ cv::Mat ReadUnchanged(const std::string& path, const char* what) {
   const std::string bytes = ReadTextFile(path);
   cv::Mat image;
   if (!bytes.empty()) {
-    image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
-                                 const_cast<char*>(bytes.data())),
-                         cv::IMREAD_UNCHANGED);
+    try {
+      image = cv::imdecode(cv::Mat(1, static_cast<int>(bytes.size()), CV_8U,
+                                   const_cast<char*>(bytes.data())),
+                           cv::IMREAD_UNCHANGED);
+    } catch (const cv::Exception& e) {  // e.g. more pixels than OpenCV decodes (2^30)
+      HAIRMVS_THROW("Cannot decode " << what << " " << path << " (" << bytes.size()
+                                     << " bytes): OpenCV refused it: " << e.err);
+    }
   }
   THROW_IF(image.empty(), "Cannot decode " << what << " " << path << " (" << bytes.size()
                                            << " bytes): truncated, or not an image format "
@@ -438,6 +448,28 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
   CHECK_GT(width, 0);
   CHECK_GT(height, 0);
   if (path.empty()) return FloatMap(width, height, 1, 1.0f);
+  // A mask of another size is taken as the same picture at another scale (COLMAP's fusion
+  // rescales masks too). Another aspect ratio cannot line up with the image, e.g. a mask drawn
+  // on a photo before colmap image_undistorter changed its size: an error, not a silently
+  // shifted mask. One pixel of rounding is allowed each way. Checked from a PNG's header
+  // before it is decoded too (a huge wrong mask takes gigabytes to decode).
+  const auto require_scaled_copy = [&](int mask_width, int mask_height) {
+    THROW_IF(!IsScaledCopy(mask_width, mask_height, width, height),
+             "Mask " << path << " is " << mask_width << " x " << mask_height
+                     << ", another aspect ratio than its image's (read at " << width << " x "
+                     << height << ")"
+                     << (IsScaledCopy(mask_height, mask_width, width, height)
+                             ? ", its width and height swapped (turned by an EXIF orientation "
+                               "that an editor applied? COLMAP ignores the tag)"
+                             : "")
+                     << ": a mask is drawn on its own image (the workspace's "
+                        "images/ as colmap image_undistorter wrote them, or the photo for "
+                        "undistort_masks), or is a scaled copy of one");
+  };
+  int header_width = 0, header_height = 0;
+  if (PngSize(path, &header_width, &header_height)) {
+    require_scaled_copy(header_width, header_height);
+  }
   const cv::Mat image = ReadUnchanged(path, "mask");
   std::vector<cv::Mat> channels;
   cv::split(image, channels);
@@ -471,21 +503,7 @@ FloatMap ReadMask(const std::string& path, int width, int height) {
   THROW_IF(num_kept == 0, "Mask " << path << " excludes every pixel (all zero at " << keep.cols
                                   << "x" << keep.rows << ")");
   if (keep.cols != width || keep.rows != height) {
-    // A mask of another size is taken as the same picture at another scale (COLMAP's fusion
-    // rescales masks too). Another aspect ratio cannot line up with the image, e.g. a mask
-    // drawn on a photo before colmap image_undistorter changed its size: an error, not a
-    // silently shifted mask. One pixel of rounding is allowed each way.
-    THROW_IF(!IsScaledCopy(keep.cols, keep.rows, width, height),
-             "Mask " << path << " is " << keep.cols << " x " << keep.rows
-                     << ", another aspect ratio than its image's (read at " << width << " x "
-                     << height << ")"
-                     << (IsScaledCopy(keep.rows, keep.cols, width, height)
-                             ? ", its width and height swapped (turned by an EXIF orientation "
-                               "that an editor applied? COLMAP ignores the tag)"
-                             : "")
-                     << ": a mask is drawn on its own image (the workspace's "
-                        "images/ as colmap image_undistorter wrote them, or the photo for "
-                        "undistort_masks), or is a scaled copy of one");
+    require_scaled_copy(keep.cols, keep.rows);
     cv::Mat resized;
     cv::resize(keep, resized, cv::Size(width, height), 0, 0, cv::INTER_NEAREST);
     keep = resized;

@@ -70,10 +70,13 @@ class Workspace {
   std::string OrientationMapProvenancePath(const std::string& name) const;
 
  private:
-  // `image` (read from ImagePath(name)), or throws naming it unless it has its camera's size.
-  FloatMap RequireCameraSize(const std::string& name, FloatMap image) const;
-  // `image` checked by RequireCameraSize, then area-resized to the processing size of
-  // max_image_size (> 0; as it is otherwise).
+  // Throws naming ImagePath(name) unless `width` x `height` is its camera's size.
+  void RequireCameraSize(const std::string& name, int width, int height) const;
+  // ImagePath(name), checked by RequireCameraSize from a PNG's header before it is decoded (an
+  // image of another size can take gigabytes to decode only to be refused).
+  std::string ImagePathOfCameraSize(const std::string& name) const;
+  // `image` (read from ImagePath(name)) checked by RequireCameraSize, then area-resized to
+  // the processing size of max_image_size (> 0; as it is otherwise).
   FloatMap AtMaxImageSize(const std::string& name, FloatMap image, int max_image_size) const;
 
   std::string path_;

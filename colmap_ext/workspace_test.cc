@@ -282,6 +282,50 @@ TEST(Images, TruncatedImagesAreErrors) {
   EXPECT_NE(ErrorOf([&] { ReadMask(empty, 4, 4); }).find("Cannot decode mask"), std::string::npos);
 }
 
+// `png`'s bytes with the IHDR chunk's width and height replaced and its CRC recomputed, so that
+// a decoder takes the header as valid (the pixel data still describes the old size).
+std::string PngStating(const std::string& png, uint32_t width, uint32_t height) {
+  std::string bytes = png;
+  const auto put = [&bytes](size_t at, uint32_t value) {
+    for (int k = 0; k < 4; ++k) bytes[at + k] = static_cast<char>(value >> (24 - 8 * k));
+  };
+  put(16, width);
+  put(20, height);
+  uint32_t crc = 0xFFFFFFFFu;  // CRC-32 of the chunk type and data (bytes 12-28), PNG's
+  for (size_t i = 12; i < 29; ++i) {
+    crc ^= static_cast<uint8_t>(bytes[i]);
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  put(29, crc ^ 0xFFFFFFFFu);
+  return bytes;
+}
+
+// An image or mask whose PNG header states another size than its camera's (or another aspect
+// ratio) is refused from the header, naming the file, without decoding it (a 40000 x 40000 PNG
+// of zeros is a few hundred kilobytes but gigabytes decoded); one OpenCV will not decode at all
+// is an error naming the file, not OpenCV's bare assertion.
+TEST(Images, HugeStatedSizesAreRefusedNamingTheFile) {
+  const std::string dir = MakeTestDir("ws_huge_png");
+  WriteTestWorkspace(dir, MakePlaneModel());  // 64 x 48 images
+  const std::string image = JoinPaths(dir, "images", "a.png");
+  const std::string png = ReadTextFile(image);
+  WriteFileAtomically(image, [&](std::ostream& out) { out << PngStating(png, 40000, 40000); });
+  const Workspace ws = Workspace::Read(dir);
+  std::string error = ErrorOf([&] { ws.ReadViewGray("a.png"); });
+  EXPECT_NE(error.find("Image " + image + " is 40000 x 40000 but its camera 1 is 64 x 48"),
+            std::string::npos)
+      << error;
+  error = ErrorOf([&] { ReadImageGray(image); });
+  EXPECT_NE(error.find("Cannot decode image " + image), std::string::npos) << error;
+  EXPECT_NE(error.find("OpenCV refused it"), std::string::npos) << error;
+  const std::string mask = JoinPaths(dir, "mask.png");
+  WriteFileAtomically(mask, [&](std::ostream& out) { out << PngStating(png, 40000, 20000); });
+  error = ErrorOf([&] { ReadMask(mask, 64, 48); });
+  EXPECT_NE(error.find("Mask " + mask + " is 40000 x 20000, another aspect ratio"),
+            std::string::npos)
+      << error;
+}
+
 TEST(Images, MaskResizedNearestAndAllZeroOrAnotherAspectIsAnError) {
   const std::string dir = MakeTestDir("masks");
   cv::Mat mask(2, 2, CV_8U, cv::Scalar(0));
