@@ -165,8 +165,8 @@ double NpyArray::AsDouble(size_t i) const {
   HAIRMVS_THROW("Not a numeric numpy dtype: " << dtype);
 }
 
-std::vector<std::string> NpyArray::Strings() const {
-  THROW_IF(!IsString(), "Expected a string (<U) array, found dtype " << dtype);
+std::vector<std::string> NpyArray::Strings(const std::string& what) const {
+  THROW_IF(!IsString(), what << ": expected a string (<U) array, found dtype " << dtype);
   const size_t chars = ItemSize() / 4;
   std::vector<std::string> out(NumElements());
   for (size_t i = 0; i < out.size(); ++i) {

@@ -49,8 +49,9 @@ struct NpyArray {
   std::vector<T> ToVector(const std::string& what = "array") const;
   // Element i as double (numeric dtypes).
   double AsDouble(size_t i) const;
-  // The elements of a <U<n> array, UTF-32 -> UTF-8, trailing NULs removed.
-  std::vector<std::string> Strings() const;
+  // The elements of a <U<n> array, UTF-32 -> UTF-8, trailing NULs removed. Throws
+  // hairmvs::Error for another dtype; `what` names the array in that message.
+  std::vector<std::string> Strings(const std::string& what = "array") const;
 
   template <typename T>
   static NpyArray FromVector(const std::vector<T>& values, std::vector<size_t> shape = {}) {

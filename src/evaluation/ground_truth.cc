@@ -25,6 +25,27 @@ void RequireShape(const NpyArray& array, const std::vector<size_t>& shape,
            what << ": expected shape " << text(shape) << ", found " << text(array.shape));
 }
 
+// Throws naming `what` and the first element that is nan or inf (or negative, unless
+// `negative_allowed`).
+void RequireFinite(const std::vector<double>& values, bool negative_allowed,
+                   const std::string& what) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    THROW_IF(!std::isfinite(values[i]) || (!negative_allowed && values[i] < 0),
+             what << ": element " << i << " is " << values[i]
+                  << (negative_allowed ? "; every element must be finite"
+                                       : "; every element must be finite and >= 0"));
+  }
+}
+
+// A scalar that is a whole number of pixels in [1, 1000000] (the readers' camera limit).
+int ImageSize(const NpyArray& array, const std::string& what) {
+  THROW_IF(array.NumElements() != 1, what << ": must be a scalar");
+  const double value = array.ToVector<double>(what)[0];
+  THROW_IF(!(value >= 1 && value <= 1000000) || value != std::floor(value),
+           what << ": " << value << " is not a whole number of pixels in 1..1000000");
+  return static_cast<int>(value);
+}
+
 }  // namespace
 
 void RequireGroundTruthDir(const std::string& gt_path) {
@@ -51,10 +72,24 @@ GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::strin
   const size_t width = depth.shape[1];
   // Named against depth: either of the two may be the wrong one.
   RequireShape(label, {height, width}, path + ": label (the shape of depth)");
+  // Depths in metres, 0 where nothing was hit; labels 0 (background), 1 (head skin), 2 (hair).
+  const std::vector<double> depths = depth.ToVector<double>(path + ": depth");
+  RequireFinite(depths, false, path + ": depth");
+  const char kind = label.dtype.size() > 1 ? label.dtype[1] : '?';
+  THROW_IF(kind != 'u' && kind != 'i' && kind != 'b',
+           path << ": label must be an integer array (0 background, 1 head skin, 2 hair), found "
+                   "dtype "
+                << label.dtype);
+  const std::vector<double> labels = label.ToVector<double>(path + ": label");
+  for (size_t i = 0; i < labels.size(); ++i) {
+    THROW_IF(labels[i] < 0 || labels[i] > 2,
+             path << ": label of pixel (" << i % width << ", " << i / width << ") is "
+                  << labels[i] << "; labels are 0 (background), 1 (head skin) or 2 (hair)");
+  }
   GroundTruthView view;
   view.depth = FloatMap(static_cast<int>(width), static_cast<int>(height), 1);
-  view.depth.Data() = depth.ToVector<float>(path + ": depth");
-  view.label = label.ToVector<uint8_t>(path + ": label");
+  view.depth.Data().assign(depths.begin(), depths.end());
+  view.label.assign(labels.begin(), labels.end());
   return view;
 }
 
@@ -84,7 +119,7 @@ GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
   const std::string path = GroundTruthCamerasPath(gt_path);
   const auto arrays = ReadNpz(path);
   GroundTruthCameras cameras;
-  cameras.names = NpzEntry(arrays, "names", path).Strings();
+  cameras.names = NpzEntry(arrays, "names", path).Strings(path + ": names");
   const size_t n = cameras.names.size();
   const NpyArray& R = NpzEntry(arrays, "R", path);
   const NpyArray& t = NpzEntry(arrays, "t", path);
@@ -95,22 +130,32 @@ GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
   const std::vector<double> r = R.ToVector<double>(path + ": R");
   const std::vector<double> tv = t.ToVector<double>(path + ": t");
   const std::vector<double> k = K.ToVector<double>(path + ": K");
+  RequireFinite(r, true, path + ": R");
+  RequireFinite(tv, true, path + ": t");
+  RequireFinite(k, true, path + ": K");
+  THROW_IF(!(k[0] > 0 && k[4] > 0),
+           path << ": K's focal lengths (" << k[0] << ", " << k[4] << ") must be > 0");
   for (size_t i = 0; i < n; ++i) {
     // C order: R[i][row][col].
     cameras.R.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(
         r.data() + 9 * i));
     cameras.t.emplace_back(tv[3 * i], tv[3 * i + 1], tv[3 * i + 2]);
+    const Eigen::Matrix3d& rotation = cameras.R.back();
+    const double off = (rotation * rotation.transpose() - Eigen::Matrix3d::Identity())
+                           .cwiseAbs()
+                           .maxCoeff();
+    THROW_IF(off > 1e-3 || rotation.determinant() < 0,
+             path << ": R[" << i << "] (" << cameras.names[i] << ") is no rotation ("
+                  << (off > 1e-3 ? "not orthonormal" : "a reflection") << ")");
   }
   cameras.K = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(k.data());
-  const NpyArray& width = NpzEntry(arrays, "width", path);
-  const NpyArray& height = NpzEntry(arrays, "height", path);
-  THROW_IF(width.NumElements() != 1 || height.NumElements() != 1,
-           path << ": width and height must be scalars");
-  cameras.width = static_cast<int>(width.AsDouble(0));
-  cameras.height = static_cast<int>(height.AsDouble(0));
+  cameras.width = ImageSize(NpzEntry(arrays, "width", path), path + ": width");
+  cameras.height = ImageSize(NpzEntry(arrays, "height", path), path + ": height");
   const auto centre = arrays.find("hair_centre");
   if (centre != arrays.end() && centre->second.NumElements() == 3) {
-    for (int j = 0; j < 3; ++j) cameras.hair_centre(j) = centre->second.AsDouble(j);
+    const std::vector<double> xyz = centre->second.ToVector<double>(path + ": hair_centre");
+    RequireFinite(xyz, true, path + ": hair_centre");
+    for (int j = 0; j < 3; ++j) cameras.hair_centre(j) = xyz[j];
   }
   return cameras;
 }

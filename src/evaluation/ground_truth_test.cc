@@ -11,6 +11,7 @@
 
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
+#include "src/core/npz.h"
 #include "src/core/test_util.h"
 #include "src/evaluation/evaluation_util.h"
 
@@ -159,6 +160,94 @@ TEST(GroundTruth, FilesRoundTrip) {
   WriteGroundTruthStrands(dir, stray);
   const std::string error = testing_util::ErrorOf([&] { ReadGroundTruthStrands(dir); });
   EXPECT_NE(error.find("strands_points.npy: point 7 is not finite"), std::string::npos) << error;
+}
+
+// Ground truth that cannot be true (a nan or negative depth, a label that is not 0-2 or is
+// stored as a float, cameras with nan, sizes that are no pixel counts, a matrix that is no
+// rotation) is refused naming the file and the array: it would otherwise score as silently
+// wrong figures (a null mean error, completeness 0, every pixel hair).
+TEST(GroundTruth, ValuesThatCannotBeTrueAreRefusedNamingTheFile) {
+  const std::string dir = MakeTestDir("bad_values");
+  const std::string view_path = JoinPaths(dir, "v0.npz");
+  const auto view_error = [&](const std::function<void(GroundTruthView*)>& edit) {
+    GroundTruthView view;
+    view.depth = FloatMap(5, 4, 1, 0.6f);
+    view.label.assign(20, kLabelHair);
+    edit(&view);
+    WriteGroundTruthView(dir, "v0.png", view);
+    return testing_util::ErrorOf([&] { ReadGroundTruthView(dir, "v0.png"); });
+  };
+  EXPECT_EQ(view_error([](GroundTruthView*) {}), "(no error)");
+  const std::vector<std::pair<std::function<void(GroundTruthView*)>, std::string>> view_cases = {
+      {[](GroundTruthView* v) { v->depth.Data()[7] = std::nanf(""); },
+       view_path + ": depth: element 7 is nan; every element must be finite and >= 0"},
+      {[](GroundTruthView* v) { v->depth.Data()[3] = -0.5f; }, ": depth: element 3 is -0.5"},
+      {[](GroundTruthView* v) { v->label[7] = 3; },
+       view_path + ": label of pixel (2, 1) is 3; labels are 0 (background), 1 (head skin) or "
+                   "2 (hair)"}};
+  for (const auto& [edit, expected] : view_cases) {
+    const std::string error = view_error(edit);
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
+  std::map<std::string, NpyArray> arrays;
+  arrays["depth"] = NpyArray::FromVector(std::vector<float>(20, 0.6f), {4, 5});
+  arrays["label"] = NpyArray::FromVector(std::vector<float>(20, 2.5f), {4, 5});
+  WriteNpz(view_path, arrays);
+  std::string error = testing_util::ErrorOf([&] { ReadGroundTruthView(dir, "v0.png"); });
+  EXPECT_NE(error.find(view_path + ": label must be an integer array"), std::string::npos)
+      << error;
+
+  GroundTruthCameras cameras;
+  cameras.names = {"v0.png", "v1.png"};
+  cameras.R = {Eigen::Matrix3d::Identity(), Eigen::Matrix3d::Identity()};
+  cameras.t = {Eigen::Vector3d(0, 0, 0.6), Eigen::Vector3d(0.1, 0, 0.6)};
+  cameras.K << 100, 0, 2.5, 0, 100, 2, 0, 0, 1;
+  cameras.width = 5;
+  cameras.height = 4;
+  const std::string cameras_path = JoinPaths(dir, "cameras.npz");
+  const auto cameras_error = [&](const std::function<void(GroundTruthCameras*)>& edit) {
+    GroundTruthCameras edited = cameras;
+    edit(&edited);
+    WriteGroundTruthCameras(dir, edited);
+    return testing_util::ErrorOf([&] { ReadGroundTruthCameras(dir); });
+  };
+  EXPECT_EQ(cameras_error([](GroundTruthCameras*) {}), "(no error)");
+  const std::vector<std::pair<std::function<void(GroundTruthCameras*)>, std::string>>
+      camera_cases = {
+          {[](GroundTruthCameras* c) { c->K(0, 0) = std::nan(""); },
+           cameras_path + ": K: element 0 is nan; every element must be finite"},
+          {[](GroundTruthCameras* c) { c->K(1, 1) = -100; }, ": K's focal lengths (100, -100)"},
+          {[](GroundTruthCameras* c) { c->t[1].y() = INFINITY; }, ": t: element 4 is inf"},
+          {[](GroundTruthCameras* c) { c->R[1](0, 1) = 0.1; },
+           cameras_path + ": R[1] (v1.png) is no rotation (not orthonormal)"},
+          {[](GroundTruthCameras* c) { c->R[0] = -Eigen::Matrix3d::Identity(); },
+           ": R[0] (v0.png) is no rotation (a reflection)"},
+          {[](GroundTruthCameras* c) { c->width = 0; },
+           cameras_path + ": width: 0 is not a whole number of pixels in 1..1000000"}};
+  for (const auto& [edit, expected] : camera_cases) {
+    error = cameras_error(edit);
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
+  // Arrays of the wrong kind: names as numbers, a size too large for an int or fractional.
+  WriteGroundTruthCameras(dir, cameras);
+  std::map<std::string, NpyArray> camera_arrays = ReadNpz(cameras_path);
+  camera_arrays["names"] = NpyArray::FromVector(std::vector<double>{1, 2});
+  camera_arrays["height"] = NpyArray::Scalar<double>(1e20);
+  WriteNpz(cameras_path, camera_arrays);
+  error = testing_util::ErrorOf([&] { ReadGroundTruthCameras(dir); });
+  EXPECT_NE(error.find(cameras_path + ": names: expected a string (<U) array, found dtype <f8"),
+            std::string::npos)
+      << error;
+  camera_arrays["names"] = NpyArray::FromStrings(cameras.names);
+  WriteNpz(cameras_path, camera_arrays);
+  error = testing_util::ErrorOf([&] { ReadGroundTruthCameras(dir); });
+  EXPECT_NE(error.find(cameras_path + ": height: 1e+20 is not a whole number of pixels"),
+            std::string::npos)
+      << error;
+  camera_arrays["height"] = NpyArray::Scalar<double>(4.5);
+  WriteNpz(cameras_path, camera_arrays);
+  error = testing_util::ErrorOf([&] { ReadGroundTruthCameras(dir); });
+  EXPECT_NE(error.find(": height: 4.5 is not a whole number"), std::string::npos) << error;
 }
 
 }  // namespace
