@@ -344,7 +344,8 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
            "Missing patch-match config (config_path): " << cfg_path);
   std::vector<PatchMatchProblem> problems;
   std::string origin_prefix;
-  if (options.use_config && ExistsFile(cfg_path)) {
+  // A folder in its place is an error (ReadPatchMatchConfig's), not a missing file.
+  if (options.use_config && (ExistsFile(cfg_path) || ExistsDir(cfg_path))) {
     problems = ReadPatchMatchConfig(cfg_path, model);
     origin_prefix = std::filesystem::path(cfg_path).filename().string();
   } else {

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <set>
 
 #include "colmap_ext/test_util.h"
@@ -124,6 +125,15 @@ TEST(SourceViews, TriangulationAngleTestsAndConfig) {
   options.config_path = JoinPaths(dir, "missing.cfg");
   EXPECT_NE(ErrorOf([&] { SelectSourceViews(ws, options); }).find("missing.cfg"),
             std::string::npos);
+  // A folder in stereo/patch-match.cfg's place is an error, not automatic source views.
+  options.config_path.clear();
+  const std::string cfg = JoinPaths(dir, "stereo", "patch-match.cfg");
+  std::filesystem::remove(cfg);
+  CreateDirs(cfg);
+  const std::string folder = ErrorOf([&] { SelectSourceViews(ws, options); });
+  EXPECT_NE(folder.find("The patch-match config " + cfg + " is a folder, not a file"),
+            std::string::npos)
+      << folder;
 }
 
 // A list longer than max_num_source_views, explicit or __all__, keeps the views sharing the

@@ -125,7 +125,8 @@ FusionOutput FuseViews(const std::vector<FusionView>& views, const TemplateFusio
     const FusionPoints points = ExtractFusionPoints(views, options, &out.num_input_points);
     THROW_IF(points.Size() < 100, "template_fusion: only " << points.Size()
                                       << " points are seen by at least "
-                                      << options.min_num_visible_views << " depth maps");
+                                      << options.min_num_visible_views << " depth maps (of the "
+                                      << views.size() << " fused)");
     out.fused = VoxelMergePoints(points, options.fused_voxel_size_px * out.footprint_m);
     // Voxels whose normals cancel are dropped: maps that face every way at once leave nothing.
     THROW_IF(out.fused.Size() < 2, "template_fusion: only "
@@ -202,7 +203,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
     // (their index in .vis stays the model's).
     std::set<std::string> listed(names.begin(), names.end());
     const std::string fusion_cfg = JoinPaths(workspace_path, "stereo", "fusion.cfg");
-    if (ExistsFile(fusion_cfg)) {
+    if (ExistsFile(fusion_cfg) || ExistsDir(fusion_cfg)) {  // a folder: ReadFusionConfig says so
       const std::vector<std::string> cfg_names = ReadFusionConfig(fusion_cfg, workspace.Model());
       listed = std::set<std::string>(cfg_names.begin(), cfg_names.end());
       if (listed.size() < names.size()) {

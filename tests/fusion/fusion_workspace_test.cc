@@ -187,6 +187,19 @@ TEST(FusionWorkspace, FusionCfgSaysWhichViewsAreFused) {
       testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), &timings); });
   EXPECT_NE(message.find(cfg), std::string::npos) << message;
   EXPECT_NE(message.find("nowhere.png"), std::string::npos) << message;
+  // One view listed: too few to fuse, said with the count of maps fused.
+  WriteFileAtomically(cfg, [&](std::ostream& out) { out << views[0].name << "\n"; });
+  const std::string one =
+      testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), &timings); });
+  EXPECT_NE(one.find("depth maps (of the 1 fused)"), std::string::npos) << one;
+  // A folder in the file's place is an error, not a fusion of every view.
+  std::filesystem::remove(cfg);
+  CreateDirs(cfg);
+  const std::string folder =
+      testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), &timings); });
+  EXPECT_NE(folder.find("The fusion config " + cfg + " is a folder, not a file"),
+            std::string::npos)
+      << folder;
   std::filesystem::remove_all(dir);
 }
 
