@@ -208,6 +208,10 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& input_path,
                                       const std::string& workspace_path,
                                       int max_image_size, bool overwrite) {
+  // As image_undistorter takes it; colmap aborts on 0 (and takes a negative one as none).
+  THROW_IF(max_image_size == 0 || max_image_size < -1,
+           "--max_image_size " << max_image_size
+                               << " must be > 0 or -1 (none), as given to image_undistorter");
   RequireDir(mask_path, "mask folder of the photos");
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
