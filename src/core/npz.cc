@@ -192,6 +192,9 @@ NpyArray NpyArray::FromStrings(const std::vector<std::string>& strings) {
   array.shape = {strings.size()};
   array.data.assign(strings.size() * max_chars * 4, 0);
   for (size_t i = 0; i < decoded.size(); ++i) {
+    // An empty string's vector may have no storage (data() null): memcpy from null is
+    // undefined even for 0 bytes (UBSan), so it is skipped; its slot stays NULs.
+    if (decoded[i].empty()) continue;
     std::memcpy(array.data.data() + i * max_chars * 4, decoded[i].data(), decoded[i].size() * 4);
   }
   return array;
