@@ -164,6 +164,9 @@ std::vector<std::string> Workspace::SelectImages(
   if (requested.empty()) return image_names_;
   std::vector<int> seen;
   for (const std::string& name : requested) {
+    THROW_IF(model_.FindImageByName(name) == nullptr,
+             "Image with name `" << name << "` (--image_names) does not exist in workspace "
+                                 << path_);
     const int idx = ImageIdx(name);
     THROW_IF(std::find(seen.begin(), seen.end(), idx) != seen.end(),
              "Image `" << name << "` is given twice (--image_names)");

@@ -33,7 +33,8 @@ TEST(Workspace, ReadsLayoutAndPaths) {
   // or one given twice refused by name.
   EXPECT_EQ(ws.SelectImages({}), ws.ImageNames());
   EXPECT_EQ(ws.SelectImages({"c.png", "a.png"}), (std::vector<std::string>{"c.png", "a.png"}));
-  EXPECT_NE(ErrorOf([&] { ws.SelectImages({"a.png", "d.png"}); }).find("`d.png` does not exist"),
+  EXPECT_NE(ErrorOf([&] { ws.SelectImages({"a.png", "d.png"}); })
+                .find("Image with name `d.png` (--image_names) does not exist in workspace"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] { ws.SelectImages({"a.png", "b.png", "a.png"}); })
                 .find("Image `a.png` is given twice"),

@@ -88,6 +88,9 @@ int RunPipeline(int argc, char** argv) {
   // Before colmap image_undistorter's minutes, not after them.
   THROW_IF(ExistsFile(workspace_path),
            "--workspace_path " << workspace_path << " is a file, not a folder");
+  if (!ground_truth_path.empty()) {  // and before the stereo's, not after the fusion
+    RequireDir(ground_truth_path, "ground truth folder (--ground_truth_path)");
+  }
 
   Timer total;
   StageTimings timings;

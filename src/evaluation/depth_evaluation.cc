@@ -221,13 +221,16 @@ bool DepthEvaluationOptions::Check(std::string* error) const {
     *error = "--silhouette_band_px must be >= 0";
     return false;
   }
-  if (layer_window_px < 0 || (layer_window_px > 0 && layer_window_px % 2 == 0)) {
-    *error = "--layer_window_px must be 0 or odd";
+  // Windows wider than any image are refused before the maps are read (one of 10^8 px ran
+  // out of memory).
+  if (layer_window_px < 0 || layer_window_px > 999 ||
+      (layer_window_px > 0 && layer_window_px % 2 == 0)) {
+    *error = "--layer_window_px must be 0 or odd, at most 999";
     return false;
   }
-  if (smooth_error_window_px < 0 ||
+  if (smooth_error_window_px < 0 || smooth_error_window_px > 999 ||
       (smooth_error_window_px > 0 && smooth_error_window_px % 2 == 0)) {
-    *error = "--smooth_error_window_px must be 0 or odd";
+    *error = "--smooth_error_window_px must be 0 or odd, at most 999";
     return false;
   }
   if (!(strand_spacing_m > 0)) {

@@ -57,6 +57,10 @@ bool MeshEvaluationOptions::Check(std::string* error) const {
     *error = "--strand_spacing_m must be > 0";
     return false;
   }
+  if (!output_json.empty() && ExistsDir(output_json)) {  // found before the work, not after
+    *error = "--output_json " + output_json + " is a folder; give the JSON file's path";
+    return false;
+  }
   return true;
 }
 

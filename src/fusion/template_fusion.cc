@@ -61,13 +61,16 @@ bool TemplateFusionOptions::Check(std::string* error) const {
   CHECK_OPTION(input_type == "auto" || input_type == "geometric" || input_type == "photometric",
                "TemplateFusion.input_type must be auto, geometric or photometric");
   CHECK_OPTION(point_stride_px >= 1, "TemplateFusion.point_stride_px must be >= 1");
-  CHECK_OPTION(fused_voxel_size_px > 0, "TemplateFusion.fused_voxel_size_px must be > 0");
+  // Upper bounds keep an absurd value from a crash or hours of work after the maps are read.
+  CHECK_OPTION(fused_voxel_size_px > 0 && fused_voxel_size_px <= 100,
+               "TemplateFusion.fused_voxel_size_px must be in (0, 100]");
   CHECK_OPTION(visibility_depth_tolerance > 0 && visibility_depth_tolerance < 1,
                "TemplateFusion.visibility_depth_tolerance must be in (0, 1)");
   CHECK_OPTION(min_num_visible_views >= 1, "TemplateFusion.min_num_visible_views must be >= 1");
   CHECK_OPTION(poisson_depth >= 3 && poisson_depth <= 12,
                "TemplateFusion.poisson_depth must be in [3, 12]");
-  CHECK_OPTION(poisson_scale >= 1, "TemplateFusion.poisson_scale must be >= 1");
+  CHECK_OPTION(poisson_scale >= 1 && poisson_scale <= 4,
+               "TemplateFusion.poisson_scale must be in [1, 4]");
   CHECK_OPTION(poisson_sample_cells > 0, "TemplateFusion.poisson_sample_cells must be > 0");
   CHECK_OPTION(trim_distance_cells > 0, "TemplateFusion.trim_distance_cells must be > 0");
   CHECK_OPTION(trim_min_sample_spacings >= 0,
@@ -79,7 +82,8 @@ bool TemplateFusionOptions::Check(std::string* error) const {
   CHECK_OPTION(node_spacing_cells > 0, "TemplateFusion.node_spacing_cells must be > 0");
   CHECK_OPTION(num_node_neighbors >= 1 && num_node_neighbors <= 8,
                "TemplateFusion.num_node_neighbors must be in [1, 8]");
-  CHECK_OPTION(num_rounds >= 0, "TemplateFusion.num_rounds must be >= 0");
+  CHECK_OPTION(num_rounds >= 0 && num_rounds <= 100,
+               "TemplateFusion.num_rounds must be in [0, 100]");
   CHECK_OPTION(fit_weight > 0, "TemplateFusion.fit_weight must be > 0");
   CHECK_OPTION(rigidity_weight >= 0, "TemplateFusion.rigidity_weight must be >= 0");
   CHECK_OPTION(smoothness_weight >= 0, "TemplateFusion.smoothness_weight must be >= 0");
@@ -92,7 +96,8 @@ bool TemplateFusionOptions::Check(std::string* error) const {
                "TemplateFusion.max_detail_offset_cells must be >= 0");
   CHECK_OPTION(max_detail_view_angle_deg > 0 && max_detail_view_angle_deg < 90,
                "TemplateFusion.max_detail_view_angle_deg must be in (0, 90)");
-  CHECK_OPTION(num_threads >= 1, "TemplateFusion.num_threads must be >= 1");
+  CHECK_OPTION(num_threads >= 1 && num_threads <= 256,
+               "TemplateFusion.num_threads must be in [1, 256]");
   return true;
 }
 

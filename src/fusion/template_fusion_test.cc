@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "src/core/test_util.h"
 #include "src/fusion/fusion_points.h"
@@ -52,6 +53,20 @@ TEST(TemplateFusion, OptionsCheck) {
   options = TemplateFusionOptions();
   options.input_type = "fancy";
   EXPECT_FALSE(options.Check(&error));
+  // Upper bounds: a thread count that crashed OpenMP, rounds that ran for hours, a Poisson box
+  // or voxel that leaves nothing to fuse.
+  const std::vector<std::pair<std::function<void(TemplateFusionOptions*)>, std::string>> cases = {
+      {[](TemplateFusionOptions* o) { o->num_threads = 257; }, "num_threads must be in [1, 256]"},
+      {[](TemplateFusionOptions* o) { o->num_rounds = 101; }, "num_rounds must be in [0, 100]"},
+      {[](TemplateFusionOptions* o) { o->poisson_scale = 4.5; }, "poisson_scale must be in [1, 4]"},
+      {[](TemplateFusionOptions* o) { o->fused_voxel_size_px = 101; },
+       "fused_voxel_size_px must be in (0, 100]"}};
+  for (const auto& [edit, expected] : cases) {
+    options = TemplateFusionOptions();
+    edit(&options);
+    EXPECT_FALSE(options.Check(&error));
+    EXPECT_NE(error.find(expected), std::string::npos) << error;
+  }
 }
 
 TEST(TemplateFusion, PointsAreSeenByTheViewsThatAgree) {

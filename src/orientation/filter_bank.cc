@@ -27,11 +27,15 @@ bool OrientationFieldOptions::Check(std::string* error) const {
   }
   if (num_orientations < 2 || num_orientations > 720)
     return fail("num_orientations must be in [2, 720]");
-  if (!(sigma_across_inner_px > 0) || !(sigma_across_outer_px > 0) || !(sigma_along_px > 0))
-    return fail("the filter sigmas must be > 0");
+  if (!(sigma_across_inner_px > 0)) return fail("sigma_across_inner_px must be > 0");
+  if (!(sigma_across_outer_px > 0)) return fail("sigma_across_outer_px must be > 0");
+  if (!(sigma_along_px > 0)) return fail("sigma_along_px must be > 0");
   if (!(sigma_across_outer_px > sigma_across_inner_px))
     return fail("sigma_across_outer_px must exceed sigma_across_inner_px (a ridge detector)");
-  if (!(confidence_gamma > 0)) return fail("confidence_gamma must be > 0");
+  // Beyond 10 the fields' magnitudes underflow to 0 in float: every field empty.
+  if (!(confidence_gamma > 0 && confidence_gamma <= 10)) {
+    return fail("confidence_gamma must be in (0, 10]");
+  }
   if (!(min_positive_response_ratio >= 0 && min_positive_response_ratio < 1))
     return fail("min_positive_response_ratio must be in [0, 1)");
   if (filter_supersampling < 1 || filter_supersampling > 16)
@@ -39,7 +43,8 @@ bool OrientationFieldOptions::Check(std::string* error) const {
   if (!(truncation_sigmas >= 1 && truncation_sigmas <= 6))
     return fail("truncation_sigmas must be in [1, 6]");
   if (truncation_sigmas * std::max(sigma_along_px, sigma_across_outer_px) > 32)
-    return fail("the filter support (truncation_sigmas * sigma) must stay within 32 px");
+    return fail("the filter support (truncation_sigmas * the larger of sigma_along_px and "
+                "sigma_across_outer_px) must stay within 32 px");
   return true;
 }
 

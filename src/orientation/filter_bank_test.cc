@@ -90,6 +90,25 @@ TEST(OrientationFieldOptions, Check) {
   options = OrientationFieldOptions();
   options.num_orientations = 1;
   EXPECT_FALSE(options.Check(&error));
+  // Each sigma is named; a confidence exponent beyond 10 (every field underflowing to 0) too.
+  for (double OrientationFieldOptions::*sigma :
+       {&OrientationFieldOptions::sigma_across_inner_px,
+        &OrientationFieldOptions::sigma_across_outer_px, &OrientationFieldOptions::sigma_along_px}) {
+    options = OrientationFieldOptions();
+    options.*sigma = 0;
+    EXPECT_FALSE(options.Check(&error));
+    EXPECT_NE(error.find("_px must be > 0"), std::string::npos) << error;
+  }
+  options = OrientationFieldOptions();
+  options.sigma_along_px = 0;
+  options.Check(&error);
+  EXPECT_NE(error.find("sigma_along_px must be > 0"), std::string::npos) << error;
+  options = OrientationFieldOptions();
+  options.confidence_gamma = 10;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options.confidence_gamma = 10.5;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("confidence_gamma must be in (0, 10]"), std::string::npos) << error;
 }
 
 }  // namespace

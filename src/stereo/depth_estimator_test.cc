@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 
 #include "hairmvs/orientation_fields.h"
 #include "src/opencl/opencl_context.h"
@@ -398,6 +399,31 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
     options.geom_consistency_max_view_angle_deg = angle;
     ExpectRefusedNaming(options, "geom_consistency_max_view_angle_deg");
   }
+  // Upper bounds on sizes and counts (beyond them a run ran out of memory mid-view, or every
+  // map came out empty), and a fine band wider than the whole range.
+  const std::vector<std::pair<std::function<void(OrientationStereoOptions*)>, std::string>>
+      bounds = {
+          {[](OrientationStereoOptions* o) { o->num_depths = 4097; },
+           "num_depths must be in [3, 4096]"},
+          {[](OrientationStereoOptions* o) { o->fine_num_labels = 257; },
+           "fine_num_labels must be in [3, 256]"},
+          {[](OrientationStereoOptions* o) { o->fine_label_step = 8.5; },
+           "the fine band (fine_num_labels x fine_label_step = 136 coarse labels) must not span "
+           "more than the num_depths 128 labels"},
+          {[](OrientationStereoOptions* o) { o->orientation_normalization_radius_px = 256; },
+           "orientation_normalization_radius_px must be in [0, 255]"},
+          {[](OrientationStereoOptions* o) { o->visual_hull_mask_dilation_px = 256; },
+           "visual_hull_mask_dilation_px must be in [0, 255]"},
+          {[](OrientationStereoOptions* o) { o->guide_rms = 1e30; },
+           "guide_rms must be in [0, 1000]"}};
+  for (const auto& [edit, expected] : bounds) {
+    options = OrientationStereoOptions();
+    edit(&options);
+    ExpectRefusedNaming(options, expected);
+  }
+  options = OrientationStereoOptions();
+  options.fine_label_step = 8;  // 16 x 8 = 128 labels: the whole range, allowed
+  EXPECT_TRUE(options.Check(&error)) << error;
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;
   EXPECT_FALSE(options.StrandPlaneFromVisualHull());

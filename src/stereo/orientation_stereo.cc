@@ -147,7 +147,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (depth_min > 0 && depth_max > 0 && depth_max <= depth_min) {
     e << "depth_max must exceed depth_min; ";
   }
-  if (num_depths < 3) e << "num_depths must be >= 3; ";
+  // Upper bounds on sizes and counts: an absurd value fails before any work, naming the
+  // option, instead of running out of memory or time in the middle of a view.
+  if (num_depths < 3 || num_depths > 4096) e << "num_depths must be in [3, 4096]; ";
   if (!(visual_hull_tolerance_m >= 0)) e << "visual_hull_tolerance_m must be >= 0; ";
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
   if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
@@ -178,7 +180,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
          "skip_existing would take the .geometric maps that the first pass wrote as done: run "
          "it without skip_existing; ";
   }
-  if (visual_hull_mask_dilation_px < 0) e << "visual_hull_mask_dilation_px must be >= 0; ";
+  if (visual_hull_mask_dilation_px < 0 || visual_hull_mask_dilation_px > 255) {
+    e << "visual_hull_mask_dilation_px must be in [0, 255]; ";
+  }
   if (visual_hull_min_carving_views < 1) e << "visual_hull_min_carving_views must be >= 1; ";
   if (num_levels < 1) e << "num_levels must be >= 1; ";
   if (!(max_strand_plane_tilt_deg >= 0 && max_strand_plane_tilt_deg < 90)) {
@@ -188,13 +192,14 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "window_px_level* must be >= 1; ";
   }
   if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
-  if (orientation_normalization_radius_px < 0) {
-    e << "orientation_normalization_radius_px must be >= 0; ";
+  if (orientation_normalization_radius_px < 0 || orientation_normalization_radius_px > 255) {
+    e << "orientation_normalization_radius_px must be in [0, 255]; ";
   }
   // A window of one valid pixel (or of equal ones) has variance 0: eps is all that divides.
   if (!(orientation_normalization_eps > 0)) e << "orientation_normalization_eps must be > 0; ";
   if (!(min_confidence >= 0)) e << "min_confidence must be >= 0; ";
-  if (!(guide_rms >= 0)) e << "guide_rms must be >= 0; ";
+  // Beyond ~1e3 the guide's squares overflow float in the guided filter: every map empty.
+  if (!(guide_rms >= 0 && guide_rms <= 1000)) e << "guide_rms must be in [0, 1000]; ";
   if (!(sigma_o > 0)) e << "sigma_o must be > 0; ";
   if (!(lambda >= 0)) e << "lambda must be >= 0; ";
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
@@ -211,8 +216,14 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "level0_weight_angle_deg must be in [0, 180); ";
   }
   if (!(level0_weight_angle_power > 0)) e << "level0_weight_angle_power must be > 0; ";
-  if (fine_num_labels < 3) e << "fine_num_labels must be >= 3; ";
-  if (!(fine_label_step > 0)) e << "fine_label_step must be > 0; ";
+  if (fine_num_labels < 3 || fine_num_labels > 256) e << "fine_num_labels must be in [3, 256]; ";
+  if (!(fine_label_step > 0)) {
+    e << "fine_label_step must be > 0; ";
+  } else if (fine_num_labels * fine_label_step > num_depths) {
+    e << "the fine band (fine_num_labels x fine_label_step = "
+      << fine_num_labels * fine_label_step << " coarse labels) must not span more than the "
+      << "num_depths " << num_depths << " labels of the whole range; ";
+  }
   if (slice_block < 1) e << "slice_block must be >= 1; ";
   if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
   if (!(photometric_weight >= 0 && photometric_weight <= 1)) {
@@ -557,6 +568,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   }
   std::fflush(stdout);
   std::set<std::string> estimated;  // views whose depth map was estimated in this run
+  std::vector<std::string> empty_maps;  // views whose written map has no depth, with why
   auto warn_no_sources = [](const std::string& name) {
     LOG(WARNING) << name << ": no source views (stereo/patch-match.cfg, or no overlapping "
                  << "view); no depth map written";
@@ -707,6 +719,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     if (!options.geom_consistency) {
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, final_type));
       ++result.num_views;
+      if (view->estimate.num_valid == 0) {
+        empty_maps.push_back(name + " (no depth estimated: the depth range, the mask, "
+                                    "min_confidence?)");
+      }
     }
   }
   progress.Finish();
@@ -950,8 +966,23 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       WriteDepthAndNormals(workspace, name, "geometric", depth, K, options.write_png);
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
       ++result.num_views;
+      if (std::none_of(depth.Data().begin(), depth.Data().end(), [](float d) { return d > 0; })) {
+        empty_maps.push_back(
+            filtered && stats.num_checked > 0
+                ? name + " (none of its " + std::to_string(stats.num_checked) +
+                      " first-estimate depths agrees with geom_consistency_min_views " +
+                      std::to_string(options.geom_consistency_min_views) +
+                      " other maps within geom_consistency_max_error_px)"
+                : name + " (no depth estimated: the depth range, the mask, min_confidence?)");
+      }
     }
     filter_progress.Finish();
+  }
+  // A map left empty is written as such (COLMAP's filter writes them too), but never silently:
+  // an option that removes everything would otherwise look like a finished run.
+  if (!empty_maps.empty()) {
+    LOG(WARNING) << empty_maps.size() << " of the " << result.num_views
+                 << " depth maps written are empty: " << JoinStrings(empty_maps, "; ");
   }
   result.seconds = total_timer.ElapsedSeconds();
   result.peak_memory_mib = PeakResidentMemoryMiB();

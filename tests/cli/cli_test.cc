@@ -90,7 +90,7 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
   CommandOutput output =
       RunHairmvs("template_fusion --workspace_path " + dir + " --TemplateFusion.num_threads 0");
   EXPECT_NE(output.exit_code, 0);
-  EXPECT_NE(output.text.find("TemplateFusion.num_threads must be >= 1"), std::string::npos)
+  EXPECT_NE(output.text.find("TemplateFusion.num_threads must be in [1, 256]"), std::string::npos)
       << output.text;
   output = RunHairmvs("evaluate_depth --workspace_path " + dir + " --ground_truth_path " + dir +
                       " --depth_type colour");
@@ -119,6 +119,16 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
   EXPECT_NE(output.text.find("--workspace_path " + file + " is a file, not a folder"),
             std::string::npos)
       << output.text;
+  // A missing ground truth folder is named before colmap image_undistorter runs, not after the
+  // stereo and the fusion.
+  const std::string no_gt = JoinPaths(dir, "no_gt");
+  output = RunHairmvs("pipeline --workspace_path " + JoinPaths(dir, "ws") + " --image_path " +
+                      dir + " --input_path " + dir + " --ground_truth_path " + no_gt);
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("Missing ground truth folder (--ground_truth_path): " + no_gt),
+            std::string::npos)
+      << output.text;
+  EXPECT_FALSE(ExistsDir(JoinPaths(dir, "ws")));
   output = RunHairmvs("import_ground_truth --ground_truth_path " + dir + " --workspace_path " +
                       dir + " --output_path " + JoinPaths(dir, "out") + " --median_filter_px 101");
   EXPECT_NE(output.exit_code, 0);

@@ -197,7 +197,7 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
   DepthEvaluationOptions unknown = FastDepthOptions();
   unknown.image_names = {"v9.png"};
   EXPECT_EQ(testing_util::ErrorOf([&] { EvaluateDepthMaps(out, scene.gt, unknown); }),
-            "Image with name `v9.png` does not exist in workspace " + out);
+            "Image with name `v9.png` (--image_names) does not exist in workspace " + out);
 }
 
 TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
@@ -372,6 +372,15 @@ TEST(EvaluationCommands, ErrorSplitIntoItsSmoothPartAndTheRest) {
   std::string error;
   EXPECT_FALSE(options.Check(&error));
   EXPECT_NE(error.find("smooth_error_window_px"), std::string::npos) << error;
+  options.smooth_error_window_px = 1001;  // wider than any image: refused before the maps
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("smooth_error_window_px must be 0 or odd, at most 999"), std::string::npos)
+      << error;
+  options.smooth_error_window_px = 0;
+  options.layer_window_px = 1001;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("layer_window_px must be 0 or odd, at most 999"), std::string::npos)
+      << error;
 }
 
 // A workspace whose v1 is off its true pose, as a mapper's poses are: 5 mm nearer the hair
@@ -686,6 +695,13 @@ TEST(EvaluationCommands, EvaluateMesh) {
   EXPECT_DOUBLE_EQ(exact.completeness_2mm, 1.0);
   EXPECT_LT(exact.completeness_distance.p90_mm, 1e-3);
   EXPECT_TRUE(ExistsFile(on_plane + ".evaluation.json"));
+  // A folder as the JSON's path is refused by Check, before the work.
+  MeshEvaluationOptions to_folder = options;
+  to_folder.output_json = scene.dir;
+  std::string folder_error;
+  EXPECT_FALSE(to_folder.Check(&folder_error));
+  EXPECT_NE(folder_error.find("--output_json " + scene.dir + " is a folder"), std::string::npos)
+      << folder_error;
 
   // 3 mm in front of the plane: accuracy 3 mm, nothing within 2 mm, everything within 5 mm.
   const std::string shifted = JoinPaths(scene.dir, "shifted.ply");

@@ -364,6 +364,45 @@ TEST(OrientationStereoWorkspace, SinglePassMapsAreNamedAsAsked) {
   std::filesystem::remove_all(path);
 }
 
+// A map left empty by the options (a confidence threshold or a consistency count nothing
+// meets) is written, as COLMAP writes such maps, but the run ends with a warning naming each
+// view and why, rather than looking like a finished run.
+TEST(OrientationStereoWorkspace, EmptyMapsAreWarnedAbout) {
+  const std::string path = MakeTestDir("stereo_empty_maps");
+  WriteWorkspace(path);
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_consistency = false;
+  options.min_confidence = 1e9;
+  StageTimings timings;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("1 of the 1 depth maps written are empty: v0.png (no depth estimated: the "
+                     "depth range, the mask, min_confidence?)"),
+            std::string::npos)
+      << log;
+  options = PlaneOptions();
+  options.geom_prior_weight = 0;  // the filter alone
+  options.geom_consistency_min_views = 99;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {}, options, &timings);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("4 of the 4 depth maps written are empty: v0.png (none of its "),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("first-estimate depths agrees with geom_consistency_min_views 99 other "
+                     "maps within geom_consistency_max_error_px); v1.png"),
+            std::string::npos)
+      << log;
+  // Maps with depths: no such warning.
+  options.geom_consistency_min_views = 1;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {}, options, &timings);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("depth maps written are empty"), std::string::npos) << log;
+  std::filesystem::remove_all(path);
+}
+
 // skip_existing (colmap patch_match_stereo's behaviour): a view whose .geometric maps exist is
 // left as it is, one whose .photometric maps exist starts at the geometric pass, the others are
 // estimated, as an interrupted run would need.
