@@ -408,21 +408,26 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
           {[](OrientationStereoOptions* o) { o->fine_num_labels = 257; },
            "fine_num_labels must be in [3, 256]"},
           {[](OrientationStereoOptions* o) { o->fine_label_step = 8.5; },
-           "the fine band (fine_num_labels x fine_label_step = 136 coarse labels) must not span "
-           "more than the num_depths 128 labels"},
+           "the fine band ((fine_num_labels - 1) x fine_label_step = 127.5 coarse labels) must "
+           "not span more than the whole range (num_depths - 1 = 127)"},
           {[](OrientationStereoOptions* o) { o->orientation_normalization_radius_px = 256; },
            "orientation_normalization_radius_px must be in [0, 255]"},
           {[](OrientationStereoOptions* o) { o->visual_hull_mask_dilation_px = 256; },
            "visual_hull_mask_dilation_px must be in [0, 255]"},
           {[](OrientationStereoOptions* o) { o->guide_rms = 1e30; },
-           "guide_rms must be in [0, 1000]"}};
+           "guide_rms must be in [0, 1000]"},
+          {[](OrientationStereoOptions* o) { o->window_px_level1 = 0; },
+           "window_px_level1 must be >= 1"}};
   for (const auto& [edit, expected] : bounds) {
     options = OrientationStereoOptions();
     edit(&options);
     ExpectRefusedNaming(options, expected);
   }
   options = OrientationStereoOptions();
-  options.fine_label_step = 8;  // 16 x 8 = 128 labels: the whole range, allowed
+  options.fine_label_step = 127.0 / 15;  // 15 steps span the 127 of the whole range: allowed
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options.coarse_level = -1;  // single stage: no fine band to check
+  options.fine_label_step = 100;
   EXPECT_TRUE(options.Check(&error)) << error;
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;

@@ -188,9 +188,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(max_strand_plane_tilt_deg >= 0 && max_strand_plane_tilt_deg < 90)) {
     e << "max_strand_plane_tilt_deg must be in [0, 90); ";
   }
-  if (window_px_level0 < 1 || window_px_level1 < 1 || window_px_level2 < 1) {
-    e << "window_px_level* must be >= 1; ";
-  }
+  if (window_px_level0 < 1) e << "window_px_level0 must be >= 1; ";
+  if (window_px_level1 < 1) e << "window_px_level1 must be >= 1; ";
+  if (window_px_level2 < 1) e << "window_px_level2 must be >= 1; ";
   if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
   if (orientation_normalization_radius_px < 0 || orientation_normalization_radius_px > 255) {
     e << "orientation_normalization_radius_px must be in [0, 255]; ";
@@ -219,10 +219,14 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (fine_num_labels < 3 || fine_num_labels > 256) e << "fine_num_labels must be in [3, 256]; ";
   if (!(fine_label_step > 0)) {
     e << "fine_label_step must be > 0; ";
-  } else if (fine_num_labels * fine_label_step > num_depths) {
-    e << "the fine band (fine_num_labels x fine_label_step = "
-      << fine_num_labels * fine_label_step << " coarse labels) must not span more than the "
-      << "num_depths " << num_depths << " labels of the whole range; ";
+  } else if (coarse_level > 0 && PyramidLevels() > 1 &&
+             (fine_num_labels - 1) * fine_label_step > num_depths - 1) {
+    // The fine stage (coarse to fine only) spans (fine_num_labels - 1) steps from its first
+    // label; the whole range, num_depths - 1 steps of a coarse label.
+    e << "the fine band ((fine_num_labels - 1) x fine_label_step = "
+      << (fine_num_labels - 1) * fine_label_step << " coarse labels) must not span more than "
+      << "the whole range (num_depths - 1 = " << num_depths - 1 << "): lower fine_num_labels "
+      << "or fine_label_step, or raise num_depths; ";
   }
   if (slice_block < 1) e << "slice_block must be >= 1; ";
   if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
@@ -970,7 +974,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         empty_maps.push_back(
             filtered && stats.num_checked > 0
                 ? name + " (none of its " + std::to_string(stats.num_checked) +
-                      " first-estimate depths agrees with geom_consistency_min_views " +
+                      " depths agrees with geom_consistency_min_views " +
                       std::to_string(options.geom_consistency_min_views) +
                       " other maps within geom_consistency_max_error_px)"
                 : name + " (no depth estimated: the depth range, the mask, min_confidence?)");

@@ -390,8 +390,8 @@ TEST(OrientationStereoWorkspace, EmptyMapsAreWarnedAbout) {
   EXPECT_NE(log.find("4 of the 4 depth maps written are empty: v0.png (none of its "),
             std::string::npos)
       << log;
-  EXPECT_NE(log.find("first-estimate depths agrees with geom_consistency_min_views 99 other "
-                     "maps within geom_consistency_max_error_px); v1.png"),
+  EXPECT_NE(log.find(" depths agrees with geom_consistency_min_views 99 other maps within "
+                     "geom_consistency_max_error_px); v1.png"),
             std::string::npos)
       << log;
   // Maps with depths: no such warning.
