@@ -774,8 +774,7 @@ Reconstruction ReadReconstruction(const std::string& dir) {
 }
 
 std::string DescribeImplausibleCameras(const Reconstruction& r, const std::string& cameras_file) {
-  std::ostringstream out;
-  size_t num_implausible = 0;
+  std::vector<std::string> implausible;
   for (const auto& [id, camera] : r.cameras) {
     const CameraModelInfo& info = CameraModelById(camera.model_id);
     if (info.num_focal_params == 0) continue;  // no focal length or principal point
@@ -799,15 +798,18 @@ std::string DescribeImplausibleCameras(const Reconstruction& r, const std::strin
       problems.push_back(problem.str());
     }
     if (problems.empty()) continue;
-    out << (num_implausible++ == 0 ? "" : "; ") << "camera " << id << " (" << info.name << ", "
-        << camera.width << " x " << camera.height << " px): " << JoinStrings(problems, ", ");
+    std::ostringstream camera_text;
+    camera_text << "camera " << id << " (" << info.name << ", " << camera.width << " x "
+                << camera.height << " px): " << JoinStrings(problems, ", ");
+    implausible.push_back(camera_text.str());
   }
-  if (num_implausible == 0) return "";
-  return cameras_file + ": " + out.str() +
-         ". COLMAP's mapper discards such calibrations (focal length 0.1-10 times the larger "
-         "side, principal point inside the image); depth maps from them come out empty or wrong.";
+  if (implausible.empty()) return "";
+  return cameras_file + ": " + JoinStrings(implausible, "; ") +
+         ". COLMAP's mapper discards such calibrations unless its "
+         "--Mapper.min/max_focal_length_ratio were changed (focal length 0.1-10 times the larger "
+         "side, principal point inside the image): check the calibration; depth maps from a "
+         "wrong one come out empty or wrong.";
 }
-
 
 std::string DescribeTrackInconsistencies(const Reconstruction& reconstruction,
                                          const std::string& points_file,

@@ -123,12 +123,13 @@ enum class ModelFormat { kBinary, kText };
 // a model with an implausible calibration, with DescribeImplausibleCameras's warning.
 Reconstruction ReadReconstruction(const std::string& dir);
 
-// COLMAP's own test of a calibration that cannot be right (Camera::HasBogusParams with the
+// COLMAP's own test of a calibration that is likely wrong (Camera::HasBogusParams with the
 // mapper's defaults, min_focal_length_ratio 0.1 and max_focal_length_ratio 10): a focal length
 // outside 0.1-10 times the larger image side, a principal point outside the image. COLMAP's
-// dense code takes such a camera as it is, and so does hairmvs, but its depth maps come out
-// empty or wrong with no other sign; so the warning names each camera and what is wrong with
-// it. Empty when every camera passes. `cameras_file` is where they were read from.
+// dense code takes such a camera as it is, and so does hairmvs; a long lens can pass the
+// limits rightly (the mapper's ratios can be changed), but a wrong calibration gives depth maps
+// that are empty or wrong with no other sign; so the warning names each camera and what is
+// wrong with it. Empty when every camera passes. `cameras_file` is where they were read from.
 std::string DescribeImplausibleCameras(const Reconstruction& reconstruction,
                                        const std::string& cameras_file);
 
