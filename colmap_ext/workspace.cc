@@ -152,10 +152,11 @@ std::vector<std::string> Workspace::ImagesWithoutMask() const {
   return names;
 }
 
-int Workspace::ImageIdx(const std::string& name) const {
+int Workspace::ImageIdx(const std::string& name, const std::string& given_by) const {
   const auto it = std::find(image_names_.begin(), image_names_.end(), name);
   THROW_IF(it == image_names_.end(),
-           "Image with name `" << name << "` does not exist in workspace " << path_);
+           "Image with name `" << name << "`" << (given_by.empty() ? "" : " (" + given_by + ")")
+                               << " does not exist in workspace " << path_);
   return static_cast<int>(it - image_names_.begin());
 }
 
@@ -164,10 +165,7 @@ std::vector<std::string> Workspace::SelectImages(
   if (requested.empty()) return image_names_;
   std::vector<int> seen;
   for (const std::string& name : requested) {
-    THROW_IF(model_.FindImageByName(name) == nullptr,
-             "Image with name `" << name << "` (--image_names) does not exist in workspace "
-                                 << path_);
-    const int idx = ImageIdx(name);
+    const int idx = ImageIdx(name, "--image_names");
     THROW_IF(std::find(seen.begin(), seen.end(), idx) != seen.end(),
              "Image `" << name << "` is given twice (--image_names)");
     seen.push_back(idx);

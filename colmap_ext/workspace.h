@@ -28,7 +28,9 @@ class Workspace {
   const Reconstruction& Model() const { return model_; }
   // Image names in COLMAP's image_idx order (the order of the records in sparse/images.*).
   const std::vector<std::string>& ImageNames() const { return image_names_; }
-  int ImageIdx(const std::string& name) const;  // throws for an unknown name
+  // Throws for an unknown name, saying where it was given (`given_by`, e.g. an option) if not
+  // empty.
+  int ImageIdx(const std::string& name, const std::string& given_by = "") const;
   // The views a command works on: `requested` (--image_names) as given, or every image when it
   // is empty. Throws for an unknown name, and for a name given twice (its maps would be
   // computed twice, and it would count as two views).
