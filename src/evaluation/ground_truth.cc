@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "colmap_ext/reconstruction.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/npz.h"
@@ -25,24 +26,30 @@ void RequireShape(const NpyArray& array, const std::vector<size_t>& shape,
            what << ": expected shape " << text(shape) << ", found " << text(array.shape));
 }
 
-// Throws naming `what` and the first element that is nan or inf (or negative, unless
-// `negative_allowed`).
-void RequireFinite(const std::vector<double>& values, bool negative_allowed,
-                   const std::string& what) {
+// Throws naming `what` and the first element that is nan or inf.
+void RequireFinite(const std::vector<double>& values, const std::string& what) {
   for (size_t i = 0; i < values.size(); ++i) {
-    THROW_IF(!std::isfinite(values[i]) || (!negative_allowed && values[i] < 0),
-             what << ": element " << i << " is " << values[i]
-                  << (negative_allowed ? "; every element must be finite"
-                                       : "; every element must be finite and >= 0"));
+    THROW_IF(!std::isfinite(values[i]),
+             what << ": element " << i << " is " << values[i] << "; every element must be finite");
   }
 }
 
-// A scalar that is a whole number of pixels in [1, 1000000] (the readers' camera limit).
+// Throws naming `what` and the first element that is nan, inf or negative (depths).
+void RequireFiniteNonNegative(const std::vector<double>& values, const std::string& what) {
+  for (size_t i = 0; i < values.size(); ++i) {
+    THROW_IF(!std::isfinite(values[i]) || values[i] < 0,
+             what << ": element " << i << " is " << values[i]
+                  << "; every element must be finite and >= 0");
+  }
+}
+
+// A scalar that is a whole number of pixels in [1, kMaxCameraSizePx] (the model readers' limit).
 int ImageSize(const NpyArray& array, const std::string& what) {
   THROW_IF(array.NumElements() != 1, what << ": must be a scalar");
   const double value = array.ToVector<double>(what)[0];
-  THROW_IF(!(value >= 1 && value <= 1000000) || value != std::floor(value),
-           what << ": " << value << " is not a whole number of pixels in 1..1000000");
+  THROW_IF(!(value >= 1 && value <= static_cast<double>(kMaxCameraSizePx)) ||
+               value != std::floor(value),
+           what << ": " << value << " is not a whole number of pixels in 1.." << kMaxCameraSizePx);
   return static_cast<int>(value);
 }
 
@@ -74,7 +81,7 @@ GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::strin
   RequireShape(label, {height, width}, path + ": label (the shape of depth)");
   // Depths in metres, 0 where nothing was hit; labels 0 (background), 1 (head skin), 2 (hair).
   const std::vector<double> depths = depth.ToVector<double>(path + ": depth");
-  RequireFinite(depths, false, path + ": depth");
+  RequireFiniteNonNegative(depths, path + ": depth");
   const char kind = label.dtype.size() > 1 ? label.dtype[1] : '?';
   THROW_IF(kind != 'u' && kind != 'i' && kind != 'b',
            path << ": label must be an integer array (0 background, 1 head skin, 2 hair), found "
@@ -130,9 +137,9 @@ GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
   const std::vector<double> r = R.ToVector<double>(path + ": R");
   const std::vector<double> tv = t.ToVector<double>(path + ": t");
   const std::vector<double> k = K.ToVector<double>(path + ": K");
-  RequireFinite(r, true, path + ": R");
-  RequireFinite(tv, true, path + ": t");
-  RequireFinite(k, true, path + ": K");
+  RequireFinite(r, path + ": R");
+  RequireFinite(tv, path + ": t");
+  RequireFinite(k, path + ": K");
   THROW_IF(!(k[0] > 0 && k[4] > 0),
            path << ": K's focal lengths (" << k[0] << ", " << k[4] << ") must be > 0");
   for (size_t i = 0; i < n; ++i) {
@@ -154,7 +161,7 @@ GroundTruthCameras ReadGroundTruthCameras(const std::string& gt_path) {
   const auto centre = arrays.find("hair_centre");
   if (centre != arrays.end() && centre->second.NumElements() == 3) {
     const std::vector<double> xyz = centre->second.ToVector<double>(path + ": hair_centre");
-    RequireFinite(xyz, true, path + ": hair_centre");
+    RequireFinite(xyz, path + ": hair_centre");
     for (int j = 0; j < 3; ++j) cameras.hair_centre(j) = xyz[j];
   }
   return cameras;

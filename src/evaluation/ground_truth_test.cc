@@ -222,6 +222,8 @@ TEST(GroundTruth, ValuesThatCannotBeTrueAreRefusedNamingTheFile) {
            cameras_path + ": R[1] (v1.png) is no rotation (not orthonormal)"},
           {[](GroundTruthCameras* c) { c->R[0] = -Eigen::Matrix3d::Identity(); },
            ": R[0] (v0.png) is no rotation (a reflection)"},
+          {[](GroundTruthCameras* c) { c->hair_centre.y() = std::nan(""); },
+           cameras_path + ": hair_centre: element 1 is nan"},
           {[](GroundTruthCameras* c) { c->width = 0; },
            cameras_path + ": width: 0 is not a whole number of pixels in 1..1000000"}};
   for (const auto& [edit, expected] : camera_cases) {
