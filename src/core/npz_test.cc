@@ -224,10 +224,15 @@ TEST(Npz, ErrorsNameTheFile) {
 // holds 4 KB: an error naming the entry, without allocating what it states (1 GB of address
 // space is enough here; the buffer was once sized from the stated size).
 TEST(Npz, StatedSizeIsNotAllocatedUpFront) {
-#if defined(__SANITIZE_ADDRESS__)
   // AddressSanitizer reserves terabytes of shadow address space: the 1 GiB RLIMIT_AS below
-  // would stop it, not the reader.
+  // would stop it, not the reader. (GCC defines __SANITIZE_ADDRESS__; clang says it through
+  // __has_feature.)
+#if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "RLIMIT_AS cannot be applied under AddressSanitizer";
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+  GTEST_SKIP() << "RLIMIT_AS cannot be applied under AddressSanitizer";
+#endif
 #endif
   const std::string dir = MakeTestDir("stated_size");
   const std::string path = JoinPaths(dir, "big.npz");

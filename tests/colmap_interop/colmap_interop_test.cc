@@ -215,6 +215,19 @@ TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
 // merely resized to the new size does not. A photo without a mask gets none; a mask of another
 // aspect ratio is named. A workspace undistorted with --max_image_size needs it given too; a
 // failure writes no mask, and masks the workspace has are replaced only when asked.
+// A --max_image_size that image_undistorter cannot take (colmap aborts on 0) is refused before
+// anything is read or run (so this needs no colmap).
+TEST(ColmapInterop, UndistortMasksRefusesABadMaxImageSize) {
+  for (const int bad : {0, -7}) {
+    const std::string error = ErrorOf([&] {
+      UndistortMasks("/nonexistent/colmap", "/no/masks", "/no/sparse", "/no/ws", bad);
+    });
+    EXPECT_NE(error.find("--max_image_size " + std::to_string(bad) + " must be > 0 or -1 (none)"),
+              std::string::npos)
+        << error;
+  }
+}
+
 TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_undistort_masks");
@@ -306,14 +319,6 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
       ErrorOf([&] { UndistortMasks(ColmapExecutable(), masks, sparse, small_path); });
   EXPECT_NE(size_error.find("--max_image_size"), std::string::npos) << size_error;
   EXPECT_FALSE(ExistsDir(JoinPaths(small_path, "masks"))) << "a failure writes no mask";
-  for (const int bad : {0, -7}) {  // colmap aborts on 0; refused before it runs
-    const std::string bad_size_error = ErrorOf(
-        [&] { UndistortMasks("/nonexistent/colmap", masks, sparse, small_path, bad); });
-    EXPECT_NE(bad_size_error.find("--max_image_size " + std::to_string(bad) +
-                                  " must be > 0 or -1 (none)"),
-              std::string::npos)
-        << bad_size_error;
-  }
   EXPECT_EQ(UndistortMasks(ColmapExecutable(), masks, sparse, small_path, 200).num_masks, 2);
   // Masks the workspace has are not replaced unless asked, and are named before colmap runs.
   const std::string small_mask_path = JoinPaths(small_path, "masks", "a.jpg.png");
