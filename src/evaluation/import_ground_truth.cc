@@ -169,6 +169,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   // Drawn from only when noise_m > 0; the standard asks for a positive deviation regardless.
   std::normal_distribution<double> noise(0.0, options.noise_m > 0 ? options.noise_m : 1.0);
   size_t kept = 0, total = 0;
+  std::vector<std::string> empty_views;  // written without a depth
   Progress progress("import_ground_truth", static_cast<int>(names.size()));
   for (const std::string& name : names) {
     progress.Start(result.num_views, name);
@@ -196,12 +197,14 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
     if (options.median_filter_px > 1 && !options.median_include_background) {
       depth = MedianFilterValidDepths(depth, options.median_filter_px);
     }
+    const size_t kept_before = kept;
     for (float& d : depth.Data()) {
       if (d > 0) {
         ++kept;
         if (options.noise_m > 0) d = static_cast<float>(std::max(1e-6, d + noise(rng)));
       }
     }
+    if (kept == kept_before) empty_views.push_back(name);
     total += depth.NumPixels();
     laps.Lap("labels, filter, noise");
     const Eigen::Matrix3d K = camera.CalibrationMatrix();
@@ -211,6 +214,15 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
     ++result.num_views;
   }
   progress.Finish();
+  if (!empty_views.empty()) {
+    LOG(WARNING) << empty_views.size() << " of the " << names.size()
+                 << " depth maps written are empty (no true depth of the kept labels left"
+                 << (options.median_filter_px > 1 && options.median_include_background
+                         ? ": a median over windows mostly background; "
+                           "--median_include_background 0 takes the kept depths only"
+                         : "")
+                 << "): " << JoinStrings(empty_views, ", ");
+  }
   result.kept_pixel_fraction = total > 0 ? static_cast<double>(kept) / total : 0.0;
   return result;
 }

@@ -112,8 +112,12 @@ MeshEvaluationResult EvaluateReadMesh(const TriangleMesh& mesh, const std::strin
   for (const Eigen::Vector3f& v : mesh.vertices) vertices.push_back(v.cast<double>());
   result.accuracy_vertices = SummarizeDistances(strand_distance.Distances(vertices));
   if (options.face_sample_spacing_m > 0) {
-    const std::vector<Eigen::Vector3d> samples =
-        SampleMeshSurface(mesh, options.face_sample_spacing_m, &rng);
+    std::vector<Eigen::Vector3d> samples;
+    try {
+      samples = SampleMeshSurface(mesh, options.face_sample_spacing_m, &rng);
+    } catch (const Error& e) {  // too many samples: a vertex far off, say; name the mesh
+      HAIRMVS_THROW(mesh_path << ": " << e.what());
+    }
     result.accuracy_surface = SummarizeDistances(strand_distance.Distances(samples));
   }
 

@@ -131,7 +131,8 @@ FusionOutput FuseViews(const std::vector<FusionView>& views, const TemplateFusio
     THROW_IF(points.Size() < 100, "template_fusion: only " << points.Size()
                                       << " points are seen by at least "
                                       << options.min_num_visible_views << " depth maps (of the "
-                                      << views.size() << " fused)");
+                                      << views.size() << " fused, a point every "
+                                      << options.point_stride_px << " px: point_stride_px)");
     out.fused = VoxelMergePoints(points, options.fused_voxel_size_px * out.footprint_m);
     // Voxels whose normals cancel are dropped: maps that face every way at once leave nothing.
     THROW_IF(out.fused.Size() < 2, "template_fusion: only "

@@ -140,6 +140,24 @@ TEST(EvaluationCommands, ImportThenEvaluateTheTruth) {
       ImportGroundTruth(scene.gt, scene.workspace, out, import_options);
   EXPECT_EQ(imported.num_views, 2);
   EXPECT_TRUE(std::filesystem::is_symlink(JoinPaths(out, "images")));
+  {
+    // A map left empty (here v1's truth holds no hair, and only hair is kept) is written, but
+    // named in a warning.
+    const std::string gt_copy = JoinPaths(scene.dir, "gt_no_hair_in_v1");
+    std::filesystem::copy(scene.gt, gt_copy);
+    GroundTruthView no_hair = ReadGroundTruthView(gt_copy, "v1.png");
+    std::replace(no_hair.label.begin(), no_hair.label.end(), kLabelHair, kLabelSkin);
+    WriteGroundTruthView(gt_copy, "v1.png", no_hair);
+    ImportGroundTruthOptions hair_only;
+    hair_only.hair_only = true;
+    ::testing::internal::CaptureStderr();
+    ImportGroundTruth(gt_copy, scene.workspace, JoinPaths(scene.dir, "empty"), hair_only);
+    const std::string log = ::testing::internal::GetCapturedStderr();
+    EXPECT_NE(log.find("1 of the 2 depth maps written are empty (no true depth of the kept "
+                       "labels left): v1.png"),
+              std::string::npos)
+        << log;
+  }
   const Workspace workspace = Workspace::Read(out);
   const std::string v1 = workspace.DepthMapPath("v1.png");
   const FloatMap depth = ReadMat(v1);
@@ -695,6 +713,15 @@ TEST(EvaluationCommands, EvaluateMesh) {
   EXPECT_DOUBLE_EQ(exact.completeness_2mm, 1.0);
   EXPECT_LT(exact.completeness_distance.p90_mm, 1e-3);
   EXPECT_TRUE(ExistsFile(on_plane + ".evaluation.json"));
+  // A vertex far off (a corrupt PLY) asks for more surface samples than memory holds: refused,
+  // naming the mesh.
+  const std::string far_off = JoinPaths(scene.dir, "far_off.ply");
+  auto far_mesh = HairPlaneMesh(0.0);
+  far_mesh.vertices[0].z() = 1e30f;
+  WriteMeshPly(far_off, far_mesh);
+  const std::string far_error =
+      testing_util::ErrorOf([&] { EvaluateMesh(far_off, scene.gt, "", options); });
+  EXPECT_NE(far_error.find(far_off + ": Sampling "), std::string::npos) << far_error;
   // A folder as the JSON's path is refused by Check, before the work.
   MeshEvaluationOptions to_folder = options;
   to_folder.output_json = scene.dir;

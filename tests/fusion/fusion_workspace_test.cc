@@ -191,7 +191,7 @@ TEST(FusionWorkspace, FusionCfgSaysWhichViewsAreFused) {
   WriteFileAtomically(cfg, [&](std::ostream& out) { out << views[0].name << "\n"; });
   const std::string one =
       testing_util::ErrorOf([&] { RunTemplateFusion(dir, EveryPixelOneThread(), &timings); });
-  EXPECT_NE(one.find("depth maps (of the 1 fused)"), std::string::npos) << one;
+  EXPECT_NE(one.find("depth maps (of the 1 fused, a point every"), std::string::npos) << one;
   // A folder in the file's place is an error, not a fusion of every view.
   std::filesystem::remove(cfg);
   CreateDirs(cfg);
