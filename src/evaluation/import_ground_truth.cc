@@ -169,7 +169,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   // Drawn from only when noise_m > 0; the standard asks for a positive deviation regardless.
   std::normal_distribution<double> noise(0.0, options.noise_m > 0 ? options.noise_m : 1.0);
   size_t kept = 0, total = 0;
-  std::vector<std::string> empty_views;  // written without a depth
+  std::vector<std::string> empty_views;  // written without a depth, with why
   Progress progress("import_ground_truth", static_cast<int>(names.size()));
   for (const std::string& name : names) {
     progress.Start(result.num_views, name);
@@ -197,6 +197,13 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
     if (options.median_filter_px > 1 && !options.median_include_background) {
       depth = MedianFilterValidDepths(depth, options.median_filter_px);
     }
+    // Whether the truth has depths of the kept labels at all (else the median is not to blame).
+    bool has_kept_depths = false;
+    for (size_t p = 0; p < view.depth.NumPixels() && !has_kept_depths; ++p) {
+      const uint8_t label = view.label[p];
+      has_kept_depths = view.depth.Data()[p] > 0 &&
+                        (label == kLabelHair || (!options.hair_only && label == kLabelSkin));
+    }
     const size_t kept_before = kept;
     for (float& d : depth.Data()) {
       if (d > 0) {
@@ -204,7 +211,13 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
         if (options.noise_m > 0) d = static_cast<float>(std::max(1e-6, d + noise(rng)));
       }
     }
-    if (kept == kept_before) empty_views.push_back(name);
+    if (kept == kept_before) {
+      empty_views.push_back(
+          has_kept_depths
+              ? name + " (a median over windows mostly background: --median_include_background "
+                       "0 takes the kept depths only)"
+              : name + " (no true depth of the kept labels)");
+    }
     total += depth.NumPixels();
     laps.Lap("labels, filter, noise");
     const Eigen::Matrix3d K = camera.CalibrationMatrix();
@@ -216,12 +229,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   progress.Finish();
   if (!empty_views.empty()) {
     LOG(WARNING) << empty_views.size() << " of the " << names.size()
-                 << " depth maps written are empty (no true depth of the kept labels left"
-                 << (options.median_filter_px > 1 && options.median_include_background
-                         ? ": a median over windows mostly background; "
-                           "--median_include_background 0 takes the kept depths only"
-                         : "")
-                 << "): " << JoinStrings(empty_views, ", ");
+                 << " depth maps written are empty: " << JoinStrings(empty_views, "; ");
   }
   result.kept_pixel_fraction = total > 0 ? static_cast<double>(kept) / total : 0.0;
   return result;

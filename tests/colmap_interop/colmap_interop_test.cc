@@ -210,11 +210,6 @@ TEST(ColmapInterop, StereoFusionFusesOurDepthAndNormalMaps) {
   EXPECT_EQ(ReadTextFile(ours + ".vis"), ReadTextFile(fused + ".vis"));
 }
 
-// Masks drawn on distorted photos are undistorted as the photos are: the written mask matches
-// the undistorted photo's own content pixel for pixel (but its rim), where the photo's mask
-// merely resized to the new size does not. A photo without a mask gets none; a mask of another
-// aspect ratio is named. A workspace undistorted with --max_image_size needs it given too; a
-// failure writes no mask, and masks the workspace has are replaced only when asked.
 // A --max_image_size that image_undistorter cannot take (colmap aborts on 0) is refused before
 // anything is read or run (so this needs no colmap).
 TEST(ColmapInterop, UndistortMasksRefusesABadMaxImageSize) {
@@ -228,6 +223,11 @@ TEST(ColmapInterop, UndistortMasksRefusesABadMaxImageSize) {
   }
 }
 
+// Masks drawn on distorted photos are undistorted as the photos are: the written mask matches
+// the undistorted photo's own content pixel for pixel (but its rim), where the photo's mask
+// merely resized to the new size does not. A photo without a mask gets none; a mask of another
+// aspect ratio is named. A workspace undistorted with --max_image_size needs it given too; a
+// failure writes no mask, and masks the workspace has are replaced only when asked.
 TEST(ColmapInterop, UndistortMasksAsThePhotos) {
   REQUIRE_COLMAP();
   const std::string dir = MakeTestDir("interop_undistort_masks");
