@@ -58,20 +58,25 @@ double MedianMm(const std::vector<double>& values_m) {
 // Where the ray of `true_camera`'s pixel (col, row) meets the depth map `depth` of `camera`
 // (the workspace's, whose pose may differ from the true one): from `start_depth` on, each step
 // takes the map's depth at the pixel where the ray's point projects, and moves along the ray to
-// that depth's z in the true camera, four steps: the two cameras being a fraction of a degree
-// apart, the pixel met settles in one or two, and at a depth edge, where it may alternate
+// that depth's z in the true camera, at most four steps: the two cameras being a fraction of a
+// degree apart, the pixel met settles in one or two (a step that meets the previous step's
+// pixel would repeat it, so the walk stops there), and at a depth edge, where it may alternate
 // between two pixels, the last is taken. `*world` is the map's point met, `*true_depth` its z
 // in the true camera. False where the ray meets a pixel without a depth or leaves the map.
 bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
                        const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
                        double* true_depth) {
   double z = start_depth;
+  int previous_col = -1, previous_row = -1;
   for (int step = 0; step < 4; ++step) {
     int map_col = 0, map_row = 0;
     double map_z = 0;
     if (!camera.Project(true_camera.BackProject(col, row, z), &map_col, &map_row, &map_z)) {
       return false;
     }
+    if (map_col == previous_col && map_row == previous_row) break;  // settled
+    previous_col = map_col;
+    previous_row = map_row;
     const float d = depth.At(map_row, map_col);
     if (!(d > 0)) return false;
     *world = camera.BackProject(map_col, map_row, d);
@@ -264,37 +269,17 @@ std::vector<std::string> DepthMapsToEvaluate(const Workspace& ws,
 
 }  // namespace
 
-DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
-                                        const std::string& ground_truth_path,
-                                        const DepthEvaluationOptions& options,
-                                        StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
-  StageLaps laps(timings);
-  // The maps looked for before the strands are indexed (seconds): a workspace without them
-  // is named at once.
-  DepthMapsToEvaluate(Workspace::Read(workspace_path), options);
-  LOG(INFO) << "Indexing the true strands of " << ground_truth_path;
-  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
-  Timer timer;
-  const StrandDistance strand_distance(strands, options.strand_spacing_m);
-  LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
-            << strand_distance.NumSamples() << " centreline samples (" << std::fixed
-            << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
-  laps.Lap("true strands");
-  return EvaluateDepthMaps(workspace_path, ground_truth_path, options, strand_distance, timings);
-}
+namespace {
 
-DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
-                                        const std::string& ground_truth_path,
-                                        const DepthEvaluationOptions& options,
-                                        const StrandDistance& strand_distance,
-                                        StageTimings* timings) {
-  std::string error;
-  THROW_IF(!options.Check(&error), error);
+// The evaluation of `names` (DepthMapsToEvaluate's) of the workspace `ws`, read once by each
+// public overload.
+DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
+                                                 const std::vector<std::string>& names,
+                                                 const std::string& ground_truth_path,
+                                                 const DepthEvaluationOptions& options,
+                                                 const StrandDistance& strand_distance,
+                                                 StageTimings* timings) {
   StageLaps laps(timings);
-  const Workspace ws = Workspace::Read(workspace_path);
-  const std::vector<std::string> names = DepthMapsToEvaluate(ws, options);
   const std::string output_path = EvaluationFolder(ws, options.output_path);
 
   const GroundTruthCameras true_cameras =
@@ -443,7 +428,7 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   result.overall = Summarize("overall", pooled);
 
   nlohmann::json json;
-  json["workspace_path"] = workspace_path;
+  json["workspace_path"] = ws.Path();
   json["ground_truth_path"] = ground_truth_path;
   json["depth_type"] = options.depth_type;
   json["pixel_convention"] = "SfM: pixel (col, row) centred at (col + 0.5, row + 0.5)";
@@ -457,6 +442,43 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
   WriteJsonSummary(result.json_path, json);
   laps.Lap("summary");
   return result;
+}
+
+}  // namespace
+
+DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
+                                        const std::string& ground_truth_path,
+                                        const DepthEvaluationOptions& options,
+                                        StageTimings* timings) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  StageLaps laps(timings);
+  // The maps looked for before the strands are indexed (seconds): a workspace without them
+  // is named at once.
+  const Workspace ws = Workspace::Read(workspace_path);
+  const std::vector<std::string> names = DepthMapsToEvaluate(ws, options);
+  LOG(INFO) << "Indexing the true strands of " << ground_truth_path;
+  const GroundTruthStrands strands = ReadGroundTruthStrands(ground_truth_path);
+  Timer timer;
+  const StrandDistance strand_distance(strands, options.strand_spacing_m);
+  LOG(INFO) << "True strands: " << strands.NumStrands() << " strands, "
+            << strand_distance.NumSamples() << " centreline samples (" << std::fixed
+            << std::setprecision(1) << timer.ElapsedSeconds() << " s)";
+  laps.Lap("true strands");
+  return EvaluateWorkspaceDepthMaps(ws, names, ground_truth_path, options, strand_distance,
+                                    timings);
+}
+
+DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
+                                        const std::string& ground_truth_path,
+                                        const DepthEvaluationOptions& options,
+                                        const StrandDistance& strand_distance,
+                                        StageTimings* timings) {
+  std::string error;
+  THROW_IF(!options.Check(&error), error);
+  const Workspace ws = Workspace::Read(workspace_path);
+  return EvaluateWorkspaceDepthMaps(ws, DepthMapsToEvaluate(ws, options), ground_truth_path,
+                                    options, strand_distance, timings);
 }
 
 }  // namespace hairmvs
