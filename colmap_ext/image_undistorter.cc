@@ -215,7 +215,8 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
   RequireDir(mask_path, "mask folder of the photos");
   const Reconstruction photos = ReadReconstruction(input_path);
   // The workspace's names are the photos'; its masks are looked up in mask_path meanwhile.
-  const Workspace workspace = Workspace::Read(workspace_path, mask_path);
+  const Workspace workspace =
+      Workspace::Read(workspace_path, mask_path, Workspace::MasksOf::kPhotos);
   const ScratchDir scratch(fs::temp_directory_path().string(), "hairmvs_masks_");
   const std::string binarised = JoinPaths(scratch.Path(), "masks");
   const std::string list_path = JoinPaths(scratch.Path(), "image_list.txt");

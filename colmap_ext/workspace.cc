@@ -43,7 +43,8 @@ bool PngSize(const std::string& path, int* width, int* height) {
 
 }  // namespace
 
-Workspace Workspace::Read(const std::string& path, const std::string& mask_path) {
+Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
+                          MasksOf masks_of) {
   THROW_IF(path.empty(), "Empty workspace path (--workspace_path)");
   THROW_IF(!ExistsDir(path), "Missing workspace folder: " << path);
   const std::string sparse = JoinPaths(path, "sparse");
@@ -77,13 +78,13 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path)
   // copy, misplaced by pixels towards the edges. Said, not refused: a mask resized on purpose
   // is read as one. (The header alone: PNG masks, as COLMAP names them.)
   std::vector<std::string> unmasked, near_size;
-  for (const std::string& name : ws.image_names_) {
-    if (ws.mask_path_.empty()) break;
+  for (const std::string& name : ws.mask_path_.empty() ? std::vector<std::string>()
+                                                        : ws.image_names_) {
     const std::string mask = ws.MaskPath(name);
     int width = 0, height = 0;
     if (mask.empty()) {
       unmasked.push_back(name);
-    } else if (PngSize(mask, &width, &height)) {
+    } else if (masks_of == MasksOf::kImages && PngSize(mask, &width, &height)) {
       const Camera& camera = ws.model_.cameras.at(ws.ImageByName(name).camera_id);
       const double scale = static_cast<double>(width) / camera.width;
       if ((width != static_cast<int>(camera.width) ||

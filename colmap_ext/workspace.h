@@ -19,10 +19,15 @@ namespace hairmvs {
 
 class Workspace {
  public:
+  // What the masks of `mask_path` are drawn on: the workspace's images (the stereo's masks) or
+  // the photos they were undistorted from (undistort_masks' input, at the photos' sizes, which
+  // are not checked against the images').
+  enum class MasksOf { kImages, kPhotos };
   // Reads the model of `path`/sparse and checks that every image of the model exists under
   // images/. `mask_path` empty: `path`/masks if that folder exists, else no masks.
   // Throws hairmvs::Error naming the file and the problem.
-  static Workspace Read(const std::string& path, const std::string& mask_path = "");
+  static Workspace Read(const std::string& path, const std::string& mask_path = "",
+                        MasksOf masks_of = MasksOf::kImages);
 
   const std::string& Path() const { return path_; }
   const Reconstruction& Model() const { return model_; }

@@ -282,8 +282,12 @@ TEST(ColmapInterop, UndistortMasksAsThePhotos) {
             std::string::npos)
       << no_mask_error;
   EXPECT_FALSE(ExistsDir(JoinPaths(workspace_path, "masks")));
+  ::testing::internal::CaptureStderr();
   const MaskUndistortionResult result =
       UndistortMasks(ColmapExecutable(), masks, sparse, workspace_path);
+  // The photos' masks are at the photos' sizes, a few percent off the images': no warning.
+  const std::string undistort_log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(undistort_log.find("a few percent off"), std::string::npos) << undistort_log;
   EXPECT_EQ(result.num_masks, 2);
   EXPECT_EQ(result.images_without_mask, std::vector<std::string>{"c.png"});
 
