@@ -8,6 +8,8 @@
 #include <cstring>
 #include <fstream>
 #include <iomanip>
+#include <mutex>
+#include <set>
 #include <sstream>
 
 #include "src/core/file_util.h"
@@ -759,6 +761,14 @@ Reconstruction ReadReconstruction(const std::string& dir) {
     THROW_IF(!r.cameras.count(image.camera_id),
              images_file << ": image " << id << " (" << image.name << ") refers to camera "
                          << image.camera_id << ", which is not in the cameras file");
+  }
+  // A command reads one model several times (a pipeline up to seven): what is wrong with it
+  // is said once per process and folder.
+  static std::mutex mutex;
+  static std::set<std::string> warned_about;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!warned_about.insert(dir).second) return r;
   }
   const std::string implausible =
       DescribeImplausibleCameras(r, JoinPaths(dir, "cameras" + extension));

@@ -686,7 +686,15 @@ TEST(Reconstruction, ImplausibleCalibrationsAreNamed) {
   }
   const std::string dir = MakeTestDir("implausible_calibration");
   WriteReconstruction(model, dir, ModelFormat::kBinary);
+  // Said once per folder however often a command reads it.
+  ::testing::internal::CaptureStderr();
   ExpectModelsEqual(model, ReadReconstruction(dir));
+  std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("camera 7 (SIMPLE_RADIAL"), std::string::npos) << log;
+  ::testing::internal::CaptureStderr();
+  ExpectModelsEqual(model, ReadReconstruction(dir));
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("camera 7 (SIMPLE_RADIAL"), std::string::npos) << log;
 }
 
 TEST(CameraModels, FocalLengthsAndParameterNames) {
