@@ -31,6 +31,10 @@ struct NpyArray {
   // Bytes per element, from the dtype (4 for "<f4", 4*n for "<U<n>").
   size_t ItemSize() const;
   bool IsString() const { return dtype.size() > 1 && dtype[1] == 'U'; }
+  // Signed or unsigned integers, or booleans.
+  bool IsInteger() const {
+    return dtype.size() > 1 && (dtype[1] == 'i' || dtype[1] == 'u' || dtype[1] == 'b');
+  }
 
   // Typed view; the dtype must be exactly NpyDtypeOf<T>() (CHECK: a caller bug otherwise).
   template <typename T>

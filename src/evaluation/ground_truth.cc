@@ -35,7 +35,7 @@ void RequireFinite(const std::vector<double>& values, const std::string& what) {
 }
 
 // Throws naming `what` and the first element that is nan, inf or negative (depths).
-void RequireFiniteNonNegative(const std::vector<double>& values, const std::string& what) {
+void RequireFiniteNonNegative(const std::vector<float>& values, const std::string& what) {
   for (size_t i = 0; i < values.size(); ++i) {
     THROW_IF(!std::isfinite(values[i]) || values[i] < 0,
              what << ": element " << i << " is " << values[i]
@@ -80,22 +80,20 @@ GroundTruthView ReadGroundTruthView(const std::string& gt_path, const std::strin
   // Named against depth: either of the two may be the wrong one.
   RequireShape(label, {height, width}, path + ": label (the shape of depth)");
   // Depths in metres, 0 where nothing was hit; labels 0 (background), 1 (head skin), 2 (hair).
-  const std::vector<double> depths = depth.ToVector<double>(path + ": depth");
-  RequireFiniteNonNegative(depths, path + ": depth");
-  const char kind = label.dtype.size() > 1 ? label.dtype[1] : '?';
-  THROW_IF(kind != 'u' && kind != 'i' && kind != 'b',
+  GroundTruthView view;
+  view.depth = FloatMap(static_cast<int>(width), static_cast<int>(height), 1);
+  view.depth.Data() = depth.ToVector<float>(path + ": depth");
+  RequireFiniteNonNegative(view.depth.Data(), path + ": depth");
+  THROW_IF(!label.IsInteger(),
            path << ": label must be an integer array (0 background, 1 head skin, 2 hair), found "
                    "dtype "
                 << label.dtype);
-  const std::vector<double> labels = label.ToVector<double>(path + ": label");
+  const std::vector<int64_t> labels = label.ToVector<int64_t>(path + ": label");
   for (size_t i = 0; i < labels.size(); ++i) {
     THROW_IF(labels[i] < 0 || labels[i] > 2,
              path << ": label of pixel (" << i % width << ", " << i / width << ") is "
                   << labels[i] << "; labels are 0 (background), 1 (head skin) or 2 (hair)");
   }
-  GroundTruthView view;
-  view.depth = FloatMap(static_cast<int>(width), static_cast<int>(height), 1);
-  view.depth.Data().assign(depths.begin(), depths.end());
   view.label.assign(labels.begin(), labels.end());
   return view;
 }
