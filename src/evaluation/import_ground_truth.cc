@@ -183,11 +183,13 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
                       << GroundTruthViewPath(ground_truth_path, name) << " is "
                       << view.depth.Width() << " x " << view.depth.Height());
     FloatMap depth = view.depth;
+    const auto keeps = [&](size_t p) {
+      const uint8_t label = view.label[p];
+      return label == kLabelHair || (!options.hair_only && label == kLabelSkin);
+    };
     auto apply_labels = [&](FloatMap* map) {
       for (size_t p = 0; p < map->NumPixels(); ++p) {
-        const uint8_t label = view.label[p];
-        const bool keep = label == kLabelHair || (!options.hair_only && label == kLabelSkin);
-        if (!keep) map->Data()[p] = 0.0f;
+        if (!keeps(p)) map->Data()[p] = 0.0f;
       }
     };
     if (options.median_filter_px > 1 && options.median_include_background) {
@@ -197,13 +199,6 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
     if (options.median_filter_px > 1 && !options.median_include_background) {
       depth = MedianFilterValidDepths(depth, options.median_filter_px);
     }
-    // Whether the truth has depths of the kept labels at all (else the median is not to blame).
-    bool has_kept_depths = false;
-    for (size_t p = 0; p < view.depth.NumPixels() && !has_kept_depths; ++p) {
-      const uint8_t label = view.label[p];
-      has_kept_depths = view.depth.Data()[p] > 0 &&
-                        (label == kLabelHair || (!options.hair_only && label == kLabelSkin));
-    }
     const size_t kept_before = kept;
     for (float& d : depth.Data()) {
       if (d > 0) {
@@ -212,6 +207,12 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
       }
     }
     if (kept == kept_before) {
+      // Whether the truth has depths of the kept labels at all (else the median is not to
+      // blame).
+      bool has_kept_depths = false;
+      for (size_t p = 0; p < view.depth.NumPixels() && !has_kept_depths; ++p) {
+        has_kept_depths = view.depth.Data()[p] > 0 && keeps(p);
+      }
       empty_views.push_back(
           has_kept_depths
               ? name + " (a median over windows mostly background: --median_include_background "
