@@ -345,7 +345,7 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
   std::vector<PatchMatchProblem> problems;
   std::string origin_prefix;
   // A folder in its place is an error (ReadPatchMatchConfig's), not a missing file.
-  if (options.use_config && (ExistsFile(cfg_path) || ExistsDir(cfg_path))) {
+  if (options.use_config && Exists(cfg_path)) {
     problems = ReadPatchMatchConfig(cfg_path, model);
     origin_prefix = std::filesystem::path(cfg_path).filename().string();
   } else {

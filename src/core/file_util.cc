@@ -41,6 +41,11 @@ bool ExistsFile(const std::string& path) {
   return fs::is_regular_file(path, ec);
 }
 
+bool Exists(const std::string& path) {
+  std::error_code ec;
+  return fs::exists(path, ec);
+}
+
 bool ExistsDir(const std::string& path) {
   std::error_code ec;
   return fs::is_directory(path, ec);

@@ -18,6 +18,8 @@ std::string JoinPaths(const std::string& a, const std::string& b, const T&... re
 }
 
 bool ExistsFile(const std::string& path);
+// Anything at `path`: a file, a folder or another kind (a link is followed).
+bool Exists(const std::string& path);
 bool ExistsDir(const std::string& path);
 // Throws hairmvs::Error naming `what` and `path` when missing.
 void RequireFile(const std::string& path, const std::string& what = "file");

@@ -208,8 +208,8 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
     // As colmap stereo_fusion: stereo/fusion.cfg, where it exists, says which views are fused
     // (their index in .vis stays the model's).
     std::set<std::string> listed(names.begin(), names.end());
-    const std::string fusion_cfg = JoinPaths(workspace_path, "stereo", "fusion.cfg");
-    if (ExistsFile(fusion_cfg) || ExistsDir(fusion_cfg)) {  // a folder: ReadFusionConfig says so
+    const std::string fusion_cfg = JoinPaths(workspace.StereoPath(), "fusion.cfg");
+    if (Exists(fusion_cfg)) {  // a folder there too: ReadFusionConfig says it is no file
       const std::vector<std::string> cfg_names = ReadFusionConfig(fusion_cfg, workspace.Model());
       listed = std::set<std::string>(cfg_names.begin(), cfg_names.end());
       if (listed.size() < names.size()) {

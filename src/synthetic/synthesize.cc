@@ -143,7 +143,7 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   const std::vector<std::string> parts = {"dense", "gt", "sparse"};
   for (const std::string& part : parts) {
     const std::string path = JoinPaths(options.output_path, part);
-    THROW_IF(ExistsFile(path) || ExistsDir(path),
+    THROW_IF(Exists(path),
              "synthesize: " << path << " exists already: give a new --output_path (or remove "
                             << "the old set first)");
   }
