@@ -219,12 +219,12 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (fine_num_labels < 3 || fine_num_labels > 256) e << "fine_num_labels must be in [3, 256]; ";
   if (!(fine_label_step > 0)) {
     e << "fine_label_step must be > 0; ";
-  } else if (coarse_level > 0 && PyramidLevels() > 1 &&
-             (fine_num_labels - 1) * fine_label_step > num_depths - 1) {
-    // The fine stage (coarse to fine only) spans (fine_num_labels - 1) steps from its first
-    // label; the whole range, num_depths - 1 steps of a coarse label.
-    e << "the fine band ((fine_num_labels - 1) x fine_label_step = "
-      << (fine_num_labels - 1) * fine_label_step << " coarse labels) must not span more than "
+  } else if (const double band = (fine_num_labels - 1) * fine_label_step;
+             coarse_level > 0 && band > num_depths - 1) {
+    // The fine stage (coarse to fine only: coarse_level > 0) spans (fine_num_labels - 1) steps
+    // from its first label; the whole range, num_depths - 1 steps of a coarse label.
+    e << "the fine band ((fine_num_labels - 1) x fine_label_step = " << band
+      << " coarse labels) must not span more than "
       << "the whole range (num_depths - 1 = " << num_depths - 1 << "): lower fine_num_labels "
       << "or fine_label_step, or raise num_depths; ";
   }
@@ -254,6 +254,10 @@ std::string OrientationStereoResult::BriefReport() const {
 }
 
 namespace {
+
+// Why a view's map may come out empty before any filter: the empty-map warning's words.
+constexpr char kNoDepthEstimatedWhy[] =
+    "no depth estimated: the depth range, the mask, min_confidence?";
 
 void WriteDepthPng(const std::string& path, const FloatMap& depth) {
   std::vector<float> valid;
@@ -724,8 +728,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, final_type));
       ++result.num_views;
       if (view->estimate.num_valid == 0) {
-        empty_maps.push_back(name + " (no depth estimated: the depth range, the mask, "
-                                    "min_confidence?)");
+        empty_maps.push_back(name + " (" + kNoDepthEstimatedWhy + ")");
       }
     }
   }
@@ -970,14 +973,17 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       WriteDepthAndNormals(workspace, name, "geometric", depth, K, options.write_png);
       result.depth_map_paths.push_back(workspace.DepthMapPath(name, "geometric"));
       ++result.num_views;
-      if (std::none_of(depth.Data().begin(), depth.Data().end(), [](float d) { return d > 0; })) {
+      const bool empty = filtered ? stats.num_kept == 0
+                                  : std::none_of(depth.Data().begin(), depth.Data().end(),
+                                                 [](float d) { return d > 0; });
+      if (empty) {
         empty_maps.push_back(
             filtered && stats.num_checked > 0
                 ? name + " (none of its " + std::to_string(stats.num_checked) +
                       " depths agrees with geom_consistency_min_views " +
                       std::to_string(options.geom_consistency_min_views) +
                       " other maps within geom_consistency_max_error_px)"
-                : name + " (no depth estimated: the depth range, the mask, min_confidence?)");
+                : name + " (" + kNoDepthEstimatedWhy + ")");
       }
     }
     filter_progress.Finish();
