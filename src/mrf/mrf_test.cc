@@ -410,11 +410,7 @@ TEST(MrfSolvers, IcmPolishEndsAtASingleSiteMinimum) {
     for (int num_labels : {1, 2, 5}) {
       const MrfProblem problem = RandomProblem(width, height, num_labels, 0.6f, ++seed);
       for (MrfSolverType type : {MrfSolverType::kSemiGlobal, MrfSolverType::kBeliefPropagation}) {
-        MrfSolverOptions options;
-        options.solver = type;
-        options.num_directions = 4;
-        options.icm_polish_iterations = 200;
-        const MrfResult result = SolveMrf(problem, options, Context().get());
+        const MrfResult result = Solve(problem, type, Context().get(), 4, 200);
         ASSERT_EQ(result.labels.size(), problem.NumPixels());
         EXPECT_NEAR(result.energy, MrfEnergy(problem, result.labels),
                     1e-5 * std::max(1.0, std::abs(result.energy)));
@@ -439,11 +435,7 @@ TEST(MrfSolvers, TiesGoToTheLowestLabelAndIcmKeepsTheCurrentOne) {
        {MrfSolverType::kSemiGlobal, MrfSolverType::kSemiGlobalCpu,
         MrfSolverType::kBeliefPropagation, MrfSolverType::kBeliefPropagationCpu,
         MrfSolverType::kWinnerTakeAll}) {
-    MrfSolverOptions options;
-    options.solver = type;
-    options.icm_polish_iterations = 0;
-    const MrfResult result =
-        SolveMrf(problem, options, UsesOpenCL(type) ? Context().get() : nullptr);
+    const MrfResult result = Solve(problem, type, UsesOpenCL(type) ? Context().get() : nullptr);
     EXPECT_EQ(result.labels, std::vector<int>(problem.NumPixels(), 0)) << ToString(type);
   }
   std::vector<int> start(problem.NumPixels());
