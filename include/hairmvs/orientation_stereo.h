@@ -620,6 +620,9 @@ struct OrientationStereoOptions {
   double LevelSourceWeight(int level, int num_levels, double view_angle_deg) const;
   // Orientation pyramid levels to compute: the data term's and the coarse stage's grid.
   int PyramidLevels() const { return std::max(num_levels, coarse_level + 1); }
+  // The fields this stereo reads: `filter`'s with PyramidLevels() levels (what orientation
+  // fields computed for it must be, to be reused).
+  OrientationFieldOptions FieldOptions(const OrientationFieldOptions& filter) const;
   // The name of the maps a view ends with: "geometric" after the geometric pass, else
   // single_pass_type.
   std::string FinalMapType() const { return geom_consistency ? "geometric" : single_pass_type; }

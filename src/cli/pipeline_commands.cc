@@ -158,10 +158,8 @@ int RunPipeline(int argc, char** argv) {
     // The fields the stereo stage reads: at its size and with its levels, so that it reuses
     // them (and their pictures) rather than computing them again.
     run_options.max_image_size = stereo_options.max_image_size;
-    OrientationFieldOptions fields = orientation_options;
-    fields.num_levels = stereo_options.PyramidLevels();
-    const OrientationFieldsResult result =
-        RunOrientationFields(workspace_path, fields, run_options, &timings);
+    const OrientationFieldsResult result = RunOrientationFields(
+        workspace_path, stereo_options.FieldOptions(orientation_options), run_options, &timings);
     std::printf("%s\n", result.BriefReport().c_str());
   }
   if (HasStage(stages, "stereo")) {

@@ -240,6 +240,13 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   return error->empty();
 }
 
+OrientationFieldOptions OrientationStereoOptions::FieldOptions(
+    const OrientationFieldOptions& filter) const {
+  OrientationFieldOptions fields = filter;
+  fields.num_levels = PyramidLevels();
+  return fields;
+}
+
 std::string OrientationStereoResult::BriefReport() const {
   std::ostringstream out;
   out << "orientation_stereo: " << num_views << " depth maps";
@@ -369,8 +376,7 @@ class ViewLoader {
     const int w = data.camera.width, h = data.camera.height;
 
     // The fields are those of the filter options in use at this size, whatever computed them.
-    OrientationFieldOptions field_options = field_options_;
-    field_options.num_levels = options_.PyramidLevels();
+    const OrientationFieldOptions field_options = options_.FieldOptions(field_options_);
     std::string provenance;
     if (options_.reuse_orientation_maps || options_.write_orientation_maps) {
       provenance = OrientationFieldsProvenance(workspace_, name, w, h, field_options);
