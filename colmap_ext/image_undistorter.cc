@@ -17,6 +17,7 @@
 
 #include "colmap_ext/reconstruction.h"
 #include "colmap_ext/workspace.h"
+#include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 
@@ -209,7 +210,7 @@ MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,
                                       const std::string& workspace_path,
                                       int max_image_size, bool overwrite) {
   // As image_undistorter takes it; colmap aborts on 0 (and takes a negative one as none).
-  THROW_IF(max_image_size == 0 || max_image_size < -1,
+  THROW_IF(!IsValidMaxImageSize(max_image_size),
            "--max_image_size " << max_image_size
                                << " must be > 0 or -1 (none), as given to image_undistorter");
   RequireDir(mask_path, "mask folder of the photos");

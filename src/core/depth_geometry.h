@@ -31,6 +31,12 @@ bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Ei
 // way: a depth map or mask that a max_image_size made smaller, not one of another aspect ratio.
 bool IsScaledCopy(int w, int h, int width, int height);
 
+// Whether `max_image_size` is one COLMAP takes: > 0, or -1 for none (colmap aborts on 0). Each
+// command words its own error.
+inline bool IsValidMaxImageSize(int max_image_size) {
+  return max_image_size > 0 || max_image_size == -1;
+}
+
 // A pinhole camera on a width x height pixel grid: X_cam = R X_world + t. The stereo's cameras
 // at the processing resolution and its pyramid levels, the evaluators' workspace and true
 // cameras (ViewCamera in colmap_ext/workspace.h builds a view's).

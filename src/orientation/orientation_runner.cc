@@ -11,6 +11,7 @@
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/workspace.h"
 #include "hairmvs/orientation_fields.h"
+#include "src/core/depth_geometry.h"
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/progress.h"
@@ -71,7 +72,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
   Timer total_timer;
   std::string error;
   THROW_IF(!options.Check(&error), "OrientationField options: " << error);
-  THROW_IF(run_options.max_image_size == 0 || run_options.max_image_size < -1,
+  THROW_IF(!IsValidMaxImageSize(run_options.max_image_size),
            "invalid --max_image_size " << run_options.max_image_size << ": must be > 0 or -1");
   Workspace workspace = [&] {
     ScopedStageTimer timer(timings, "read workspace");

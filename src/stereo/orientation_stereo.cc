@@ -143,7 +143,7 @@ double OrientationStereoOptions::LevelSourceWeight(int level, int num_levels,
 bool OrientationStereoOptions::Check(std::string* error) const {
   std::ostringstream e;
   MrfSolverType solver;
-  if (max_image_size == 0 || max_image_size < -1) e << "max_image_size must be > 0 or -1; ";
+  if (!IsValidMaxImageSize(max_image_size)) e << "max_image_size must be > 0 or -1; ";
   if (depth_min > 0 && depth_max > 0 && depth_max <= depth_min) {
     e << "depth_max must exceed depth_min; ";
   }
