@@ -182,15 +182,24 @@ void RemoveTemporariesAndDie(int signal_number) {
   raise(signal_number);
 }
 
+// The host name alone ("localhost" where there is none): the tag of the names written before the
+// PID namespace was part of it, which count as this host's too.
+const std::string& HostName() {
+  static const std::string host_name = [] {  // the same for the process's life
+    char name[256] = {};
+    const bool named = gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0';
+    return std::string(named ? name : "localhost");
+  }();
+  return host_name;
+}
+
 // This host and its PID namespace, "<host name>~<namespace inode>": a process id names one
 // process only within both. Containers on one host may share its name but each have a PID
 // namespace of their own, with the same pids, so a run looks up the processes of the files of
 // its own host and namespace only.
 const std::string& HostTag() {
   static const std::string host_tag = [] {  // the same for the process's life
-    char name[256] = {};
-    std::string tag =
-        gethostname(name, sizeof(name) - 1) == 0 && name[0] != '\0' ? name : "localhost";
+    std::string tag = HostName();
     char link[64] = {};  // "pid:[4026531836]"
     const ssize_t length = readlink("/proc/self/ns/pid", link, sizeof(link) - 1);
     if (length > 0) {
@@ -255,7 +264,7 @@ long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) 
   static const std::regex kOlder(R"(\..*\.tmp([0-9]{1,9})_[0-9]+)");
   const std::string extension = fs::path(name).extension().string();
   // The host name alone: the form before the PID namespace was part of the tag.
-  const std::string host_name = host.substr(0, host.find('~'));
+  const std::string& host_name = HostName();
   std::smatch match;
   for (const std::string& end : {"@" + host + extension, "@" + host, "@" + host_name + extension,
                                  "@" + host_name}) {
@@ -407,7 +416,7 @@ void RemoveScratchOfEndedRuns(const std::string& parent, const std::string& pref
     const size_t at = rest.find('@', digits);
     // The host name alone (the form before the PID namespace was part of the tag) counts too.
     if (at != std::string::npos && rest.substr(at + 1) != host &&
-        rest.substr(at + 1) != host.substr(0, host.find('~'))) {
+        rest.substr(at + 1) != HostName()) {
       continue;
     }
     const long pid = std::stol(rest.substr(0, digits));
