@@ -1,5 +1,6 @@
 #include "src/core/option_parser.h"
 
+#include <algorithm>
 #include <boost/program_options.hpp>
 #include <cmath>
 #include <iostream>
@@ -166,6 +167,8 @@ bool InSections(const std::string& key, const std::vector<std::string>& sections
 
 bool OptionParser::Parse(int argc, char** argv, int first) {
   std::vector<std::string> args(argv + first, argv + argc);
+  // The project file's options without effect here (named in one warning of their own).
+  std::vector<std::string> not_used;
   try {
     // A word that is not an option (a value given twice, a forgotten "--") is an error naming
     // it rather than dropped: every positional word lands in a hidden option, refused below.
@@ -200,11 +203,11 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       }
       // The file's options that take effect, and those of our sections without effect (named
       // once here, rather than warned about one by one: a generated file lists them all).
-      std::vector<std::string> used, not_used;
+      std::vector<std::string> used;
       for (const po::option& option : from_file.options) {
         const std::string& key = option.string_key;
-        // Given on the command line: that value wins.
-        if (impl_->vm.count(key) && !impl_->vm[key].defaulted()) continue;
+        // Given on the command line (the file's values are not stored yet): that value wins.
+        if (WasGiven(key)) continue;
         if (!option.unregistered && impl_->ignored.count(key) == 0) {
           used.push_back(key + "=" + (option.value.empty() ? "" : option.value.front()));
           impl_->from_project_file.insert(key);
@@ -213,7 +216,6 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
           // Ignored here (colmap's top-level log_level too), or unknown in our sections; other
           // commands' sections are passed over.
           not_used.push_back(key);
-          impl_->ignored.erase(key);
         }
       }
       po::store(from_file, impl_->vm);
@@ -244,7 +246,9 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
                                       << ": not a finite number");
   }
   for (const auto& [name, why] : impl_->ignored) {
-    if (impl_->vm.count(name)) {
+    // Those the project file set are named in its one warning above.
+    const bool named_above = std::find(not_used.begin(), not_used.end(), name) != not_used.end();
+    if (impl_->vm.count(name) && !named_above) {
       LOG(WARNING) << "--" << name << " is ignored by hairmvs: " << why;
     }
   }
