@@ -180,35 +180,29 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
        "geom_consistency_max_error_px", filter_geom_consistency_max_cost, 1,
        [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
   };
-  // A project file that colmap wrote lists every option, most at colmap's defaults: where
-  // hairmvs's differ on purpose, colmap's from the file are left to them; given on the command
-  // line they apply.
-  std::vector<std::string> left_to_hairmvs;
+  // Each colmap option given (on the command line or in a project file) applies, except:
+  // - a project file that colmap wrote lists every option, most at colmap's defaults: where
+  //   hairmvs's differ on purpose, colmap's from the file are left to them (given on the
+  //   command line they apply);
+  // - the command line wins over the file: a file's value is not applied over the hairmvs
+  //   option it sets when that option is given.
+  std::vector<std::string> left_to_hairmvs, overridden;
   for (const MappedOption& option : mapped) {
-    if (parser.FromProjectFile(option.colmap_name) && option.value == option.colmap_default) {
+    if (!parser.WasGiven(option.colmap_name)) continue;
+    const bool from_file = parser.FromProjectFile(option.colmap_name);
+    const std::string own = std::string(option.section) + "." + option.field;
+    if (from_file && option.value == option.colmap_default) {
       left_to_hairmvs.push_back(option.colmap_name);
+    } else if (from_file && parser.WasGiven(own)) {
+      overridden.push_back(std::string(option.colmap_name) + " (--" + own + " given)");
+    } else {
+      option.apply();
     }
   }
   if (!left_to_hairmvs.empty()) {
     LOG(INFO) << "the project file's " << JoinStrings(left_to_hairmvs, ", ")
               << " are colmap's defaults: not applied, hairmvs's own apply (give them on the "
                  "command line to override)";
-  }
-  // The command line wins over the file: a file's value is not applied over the hairmvs option
-  // it sets when that option is given.
-  std::vector<std::string> overridden;
-  for (const MappedOption& option : mapped) {
-    if (!parser.WasGiven(option.colmap_name) ||
-        std::find(left_to_hairmvs.begin(), left_to_hairmvs.end(), option.colmap_name) !=
-            left_to_hairmvs.end()) {
-      continue;
-    }
-    const std::string own = std::string(option.section) + "." + option.field;
-    if (parser.FromProjectFile(option.colmap_name) && parser.WasGiven(own)) {
-      overridden.push_back(std::string(option.colmap_name) + " (--" + own + " given)");
-      continue;
-    }
-    option.apply();
   }
   if (!overridden.empty()) {
     LOG(INFO) << "the project file's " << JoinStrings(overridden, ", ")
