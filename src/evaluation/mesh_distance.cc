@@ -53,7 +53,8 @@ double PointTriangleDistance(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
 }
 
 std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double spacing_m,
-                                               std::mt19937* rng) {
+                                               std::mt19937* rng,
+                                               const std::string& mesh_source) {
   CHECK_GT(spacing_m, 0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   std::vector<Eigen::Vector3d> samples;
@@ -70,7 +71,8 @@ std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double 
   }
   // Before a per-face count overflows int or the samples fill the memory.
   THROW_IF(area_m2 / cell > kMaxDistanceSamples,
-           "Sampling " << area_m2 << " m^2 of mesh every " << spacing_m << " m would take "
+           mesh_source << ": sampling " << area_m2 << " m^2 of mesh every " << spacing_m
+                       << " m would take "
                        << area_m2 / cell << " samples; use a larger sample spacing");
   for (size_t face = 0; face < mesh.faces.size(); ++face) {
     const Eigen::Vector3i& f = mesh.faces[face];
@@ -140,7 +142,8 @@ class NearestFaceResult {
 
 }  // namespace
 
-TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double sample_spacing_m)
+TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double sample_spacing_m,
+                                           const std::string& mesh_source)
     : index_(std::make_unique<Index>()) {
   THROW_IF(!(sample_spacing_m > 0), "TriangleMeshDistance: sample spacing must be > 0");
   THROW_IF(mesh.faces.empty(), "TriangleMeshDistance: the mesh has no faces");
@@ -165,7 +168,8 @@ TriangleMeshDistance::TriangleMeshDistance(const TriangleMesh& mesh, double samp
     num_samples += (steps[fi] + 1) * (steps[fi] + 2) / 2;
   }
   THROW_IF(num_samples > kMaxDistanceSamples,
-           "Sampling the mesh's " << mesh.faces.size() << " faces every " << sample_spacing_m
+           mesh_source << ": sampling the " << mesh.faces.size() << " faces every "
+                       << sample_spacing_m
                                   << " m would take " << num_samples
                                   << " samples; use a larger sample spacing");
   for (size_t fi = 0; fi < mesh.faces.size(); ++fi) {

@@ -20,13 +20,17 @@ double PointTriangleDistance(const Eigen::Vector3d& x, const Eigen::Vector3d& a,
                              const Eigen::Vector3d& b, const Eigen::Vector3d& c);
 
 // Points uniformly distributed over the mesh surface, on average one per spacing^2 of area
-// (per face: floor(area / s^2) points plus one more with the remaining probability).
+// (per face: floor(area / s^2) points plus one more with the remaining probability). Throws
+// naming `mesh_source` (the mesh's file) when they would fill the memory.
 std::vector<Eigen::Vector3d> SampleMeshSurface(const TriangleMesh& mesh, double spacing_m,
-                                               std::mt19937* rng);
+                                               std::mt19937* rng,
+                                               const std::string& mesh_source = "mesh");
 
 class TriangleMeshDistance {
  public:
-  TriangleMeshDistance(const TriangleMesh& mesh, double sample_spacing_m = 1e-3);
+  // Throws naming `mesh_source` (the mesh's file) when the index would fill the memory.
+  TriangleMeshDistance(const TriangleMesh& mesh, double sample_spacing_m = 1e-3,
+                       const std::string& mesh_source = "mesh");
   ~TriangleMeshDistance();
 
   double Distance(const Eigen::Vector3d& x) const;

@@ -112,12 +112,8 @@ MeshEvaluationResult EvaluateReadMesh(const TriangleMesh& mesh, const std::strin
   for (const Eigen::Vector3f& v : mesh.vertices) vertices.push_back(v.cast<double>());
   result.accuracy_vertices = SummarizeDistances(strand_distance.Distances(vertices));
   if (options.face_sample_spacing_m > 0) {
-    std::vector<Eigen::Vector3d> samples;
-    try {
-      samples = SampleMeshSurface(mesh, options.face_sample_spacing_m, &rng);
-    } catch (const Error& e) {  // too many samples: a vertex far off, say; name the mesh
-      HAIRMVS_THROW(mesh_path << ": " << e.what());
-    }
+    const std::vector<Eigen::Vector3d> samples =
+        SampleMeshSurface(mesh, options.face_sample_spacing_m, &rng, mesh_path);
     result.accuracy_surface = SummarizeDistances(strand_distance.Distances(samples));
   }
 
@@ -153,7 +149,7 @@ MeshEvaluationResult EvaluateReadMesh(const TriangleMesh& mesh, const std::strin
                         " true surface points to the mesh");
   std::vector<Eigen::Vector3d> queries;
   for (const Eigen::Vector3f& p : surface) queries.push_back(p.cast<double>());
-  const TriangleMeshDistance mesh_distance(mesh, options.surface_sample_spacing_m);
+  const TriangleMeshDistance mesh_distance(mesh, options.surface_sample_spacing_m, mesh_path);
   const std::vector<double> completeness = mesh_distance.Distances(queries);
   long within2 = 0, within5 = 0;
   for (double d : completeness) {

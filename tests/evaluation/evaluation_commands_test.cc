@@ -721,7 +721,7 @@ TEST(EvaluationCommands, EvaluateMesh) {
   WriteMeshPly(far_off, far_mesh);
   const std::string far_error =
       testing_util::ErrorOf([&] { EvaluateMesh(far_off, scene.gt, "", options); });
-  EXPECT_NE(far_error.find(far_off + ": Sampling "), std::string::npos) << far_error;
+  EXPECT_NE(far_error.find(far_off + ": sampling "), std::string::npos) << far_error;
   // A folder as the JSON's path is refused by Check, before the work.
   MeshEvaluationOptions to_folder = options;
   to_folder.output_json = scene.dir;
