@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "src/core/file_util.h"
@@ -102,21 +103,22 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
     // a choice to match the whole scene. And a folder given for the masks that holds none is a
     // wrong folder; the workspace's own masks/ left empty is taken as no masks (warned about
     // below).
-    std::string holds = "no image file";
+    std::optional<std::string> first_image_file;
     std::error_code ec;
     for (const auto& entry : fs::directory_iterator(ws.mask_path_, ec)) {
       const std::string extension = ToLower(entry.path().extension().string());
       if (entry.is_regular_file(ec) && entry.path().filename().string()[0] != '.' &&
           (extension == ".png" || extension == ".jpg" || extension == ".jpeg" ||
            extension == ".bmp" || extension == ".tif" || extension == ".tiff")) {
-        holds = entry.path().filename().string();
+        first_image_file = entry.path().filename().string();
         break;
       }
     }
-    const bool holds_images = holds != "no image file";
+    const bool holds_images = first_image_file.has_value();
     THROW_IF(holds_images || !mask_path.empty(),
              "No mask in " << ws.mask_path_ << (holds_images ? "" : " (the mask folder given)")
-                           << " belongs to an image of the workspace: it holds " << holds
+                           << " belongs to an image of the workspace: it holds "
+                           << first_image_file.value_or("no image file")
                            << (holds_images ? ", but" : ";") << " the mask of the image "
                            << ws.image_names_.front() << " is "
                            << JoinPaths(ws.mask_path_, ws.image_names_.front() + ".png")
