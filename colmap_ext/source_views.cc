@@ -304,8 +304,12 @@ bool SourceViewOptions::Check(std::string* error) const {
   if (!(epipolar_spread_weight >= 0)) e << "epipolar_spread_weight must be >= 0. ";
   if (!(max_triangulation_angle_deg > min_triangulation_angle_deg)) {
     e << "max_triangulation_angle_deg must exceed min_triangulation_angle_deg. ";
+  } else if (!(max_triangulation_angle_deg <= 180)) {
+    e << "max_triangulation_angle_deg must be at most 180. ";
   }
-  if (!(t_group_max_view_angle_deg > 0)) e << "t_group_max_view_angle_deg must be > 0. ";
+  if (!(t_group_max_view_angle_deg > 0 && t_group_max_view_angle_deg <= 180)) {
+    e << "t_group_max_view_angle_deg must be in (0, 180]. ";
+  }
   if (!(t_group_max_axis_angle_deg > 0 && t_group_max_axis_angle_deg < 45)) {
     e << "t_group_max_axis_angle_deg must be in (0, 45). ";
   }

@@ -44,6 +44,27 @@ Workspace WriteAndRead(const std::string& name, const Reconstruction& model) {
   return Workspace::Read(dir);
 }
 
+// The defaults pass; angles beyond a half turn (views cannot be further apart) are refused by
+// name, as are the other bounds.
+TEST(SourceViews, OptionsAreChecked) {
+  SourceViewOptions options;
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options.max_triangulation_angle_deg = 181;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("max_triangulation_angle_deg must be at most 180"), std::string::npos)
+      << error;
+  options = SourceViewOptions();
+  options.t_group_max_view_angle_deg = 200;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("t_group_max_view_angle_deg must be in (0, 180]"), std::string::npos)
+      << error;
+  options = SourceViewOptions();
+  options.max_num_source_views = 0;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("max_num_source_views"), std::string::npos) << error;
+}
+
 TEST(SourceViews, EpipolarSpreadPrefersADifferentDirection) {
   // ref, three horizontal neighbours sharing 40 points, one vertical sharing 20.
   std::vector<unsigned> visibility(40, 0b01111u);

@@ -334,7 +334,7 @@ struct OrientationStereoOptions {
   // mm, synth_handheld 92.0% / 5.38 mm (absolute 1e-3: 98.6% / 4.32, 92.2% / 5.41); absolute
   // 1e-2 97.7% / 4.40 and 87.7% / 5.89 mm.
   double orientation_normalization_eps = 0.1;
-  // Photometric and combined costs: NCC window (px) at every level.
+  // Photometric and combined costs: NCC window (px, odd) at every level.
   int ncc_window_px = 7;
   // Combined cost only: the photometric cost's share of the data term, the orientation cost
   // having the rest (both are sums over the source views of terms in [-1, 1], so equal shares
@@ -529,9 +529,9 @@ struct OrientationStereoOptions {
     v("depth_sampling", &depth_sampling, "depth|inverse_depth: label spacing");
     v("num_depths", &num_depths, "labels over the full depth range");
     v("num_levels", &num_levels, "orientation pyramid levels in the data term (paper: 3)");
-    v("window_px_level0", &window_px_level0, "guided filter window at level 0 (finest), px");
-    v("window_px_level1", &window_px_level1, "guided filter window at level 1, px");
-    v("window_px_level2", &window_px_level2, "guided filter window at level 2, px");
+    v("window_px_level0", &window_px_level0, "guided filter window at level 0 (finest), px (odd)");
+    v("window_px_level1", &window_px_level1, "guided filter window at level 1, px (odd)");
+    v("window_px_level2", &window_px_level2, "guided filter window at level 2, px (odd)");
     v("guide_rms", &guide_rms,
       "scale the reference field to this RMS magnitude as guide and smoothness weight (0: off)");
     v("guided_filter_eps", &guided_filter_eps, "guided filter eps (paper: 0.12)");
@@ -546,7 +546,7 @@ struct OrientationStereoOptions {
     v("coarse_level", &coarse_level,
       "orientation level whose grid the full-range MRF uses (-1: single stage at full size)");
     v("coarse_first_level", &coarse_first_level,
-      "finest pyramid level in the coarse stage's data term (0: all)");
+      "finest pyramid level in the coarse stage's data term (0: all; at most coarse_level)");
     v("coarse_labels_from_visual_hull", &coarse_labels_from_visual_hull,
       "with masks: coarse labels start at the visual hull's bound at each pixel");
     v("coarse_smoothness_along_visual_hull", &coarse_smoothness_along_visual_hull,
@@ -572,7 +572,7 @@ struct OrientationStereoOptions {
       "match (O - local mean) / local std over this window radius (0: raw O, the paper)");
     v("orientation_normalization_eps", &orientation_normalization_eps,
       "regulariser of the local variance in the normalisation (x the field's mean |O|^2)");
-    v("ncc_window_px", &ncc_window_px, "photometric and combined costs: NCC window in px");
+    v("ncc_window_px", &ncc_window_px, "photometric and combined costs: NCC window in px (odd)");
     v("photometric_weight", &photometric_weight,
       "combined cost: the photometric cost's share of the data term, in [0, 1]");
     v("best_source_fraction", &best_source_fraction,

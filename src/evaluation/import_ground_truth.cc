@@ -100,8 +100,9 @@ void UseTrueCameraPoses(const std::string& ground_truth_path,
 }  // namespace
 
 bool ImportGroundTruthOptions::Check(std::string* error) const {
-  if (!(noise_m >= 0)) {
-    *error = "--noise_m must be >= 0";
+  // A metre of noise is no depth map (and an infinite one writes infinite depths).
+  if (!(noise_m >= 0 && noise_m <= 1)) {
+    *error = "--noise_m must be in [0, 1] (metres)";
     return false;
   }
   if (median_filter_px < 0 || median_filter_px > kMaxMedianFilterPx ||

@@ -417,7 +417,17 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
           {[](OrientationStereoOptions* o) { o->guide_rms = 1e30; },
            "guide_rms must be in [0, 1000]"},
           {[](OrientationStereoOptions* o) { o->window_px_level1 = 0; },
-           "window_px_level1 must be >= 1"}};
+           "window_px_level1 must be odd, in [1, 511]"},
+          // Centred windows: an even width worked as the next odd one without a word.
+          {[](OrientationStereoOptions* o) { o->window_px_level0 = 14; },
+           "window_px_level0 must be odd, in [1, 511]"},
+          {[](OrientationStereoOptions* o) { o->ncc_window_px = 8; },
+           "ncc_window_px must be odd, in [1, 511]"},
+          {[](OrientationStereoOptions* o) { o->ncc_window_px = 100001; },
+           "ncc_window_px must be odd, in [1, 511]"},
+          // Beyond the coarse grid's level it was clamped to it without a word.
+          {[](OrientationStereoOptions* o) { o->coarse_first_level = 3; },
+           "coarse_first_level must be at most coarse_level and below num_levels"}};
   for (const auto& [edit, expected] : bounds) {
     options = OrientationStereoOptions();
     edit(&options);
@@ -426,8 +436,12 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   options = OrientationStereoOptions();
   options.fine_label_step = 127.0 / 15;  // 15 steps span the 127 of the whole range: allowed
   EXPECT_TRUE(options.Check(&error)) << error;
-  options.coarse_level = -1;  // single stage: no fine band to check
+  options.coarse_level = -1;  // single stage: no fine band nor coarse levels to check
   options.fine_label_step = 100;
+  options.coarse_first_level = 3;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  options = OrientationStereoOptions();
+  options.coarse_first_level = 2;  // the coarse grid's own level: allowed
   EXPECT_TRUE(options.Check(&error)) << error;
   options = OrientationStereoOptions();
   options.orientation_transfer = OrientationTransfer::kEpipoleRoll;

@@ -15,6 +15,7 @@
 #include <opencv2/imgproc.hpp>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/source_views.h"
@@ -188,9 +189,16 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(max_strand_plane_tilt_deg >= 0 && max_strand_plane_tilt_deg < 90)) {
     e << "max_strand_plane_tilt_deg must be in [0, 90); ";
   }
-  if (window_px_level0 < 1) e << "window_px_level0 must be >= 1; ";
-  if (window_px_level1 < 1) e << "window_px_level1 must be >= 1; ";
-  if (window_px_level2 < 1) e << "window_px_level2 must be >= 1; ";
+  // Windows are centred on their pixel (radius window / 2): an even width would silently work
+  // as the next odd one.
+  for (const auto& [window, name] : {std::pair{window_px_level0, "window_px_level0"},
+                                     std::pair{window_px_level1, "window_px_level1"},
+                                     std::pair{window_px_level2, "window_px_level2"},
+                                     std::pair{ncc_window_px, "ncc_window_px"}}) {
+    if (window < 1 || window > 511 || window % 2 == 0) {
+      e << name << " must be odd, in [1, 511] (a window centred on its pixel); ";
+    }
+  }
   if (!(guided_filter_eps > 0)) e << "guided_filter_eps must be > 0; ";
   if (orientation_normalization_radius_px < 0 || orientation_normalization_radius_px > 255) {
     e << "orientation_normalization_radius_px must be in [0, 255]; ";
@@ -211,7 +219,12 @@ bool OrientationStereoOptions::Check(std::string* error) const {
     e << "num_levels and coarse_level + 1 must be at most " << OrientationFieldOptions::kMaxLevels
       << "; ";
   }
-  if (coarse_first_level < 0) e << "coarse_first_level must be >= 0; ";
+  if (coarse_first_level < 0) {
+    e << "coarse_first_level must be >= 0; ";
+  } else if (coarse_level > 0 && coarse_first_level > std::min(coarse_level, num_levels - 1)) {
+    // Beyond them the coarse stage would quietly use level min(coarse_level, num_levels - 1).
+    e << "coarse_first_level must be at most coarse_level and below num_levels; ";
+  }
   if (!(level0_weight_angle_deg >= 0 && level0_weight_angle_deg < 180)) {
     e << "level0_weight_angle_deg must be in [0, 180); ";
   }
@@ -229,7 +242,6 @@ bool OrientationStereoOptions::Check(std::string* error) const {
       << "or fine_label_step, or raise num_depths; ";
   }
   if (slice_block < 1) e << "slice_block must be >= 1; ";
-  if (ncc_window_px < 1) e << "ncc_window_px must be >= 1; ";
   if (!(photometric_weight >= 0 && photometric_weight <= 1)) {
     e << "photometric_weight must be in [0, 1]; ";
   }

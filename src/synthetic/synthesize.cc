@@ -109,6 +109,8 @@ bool SynthesizeOptions::Check(std::string* error) const {
     e << "num_views must be 0 or in [2, 100]; ";
   }
   if (width < 32 || width > 8192) e << "width must be in [32, 8192]; ";
+  // The seed is taken as unsigned: -1 would quietly be 2^64 - 1.
+  if (seed < 0) e << "seed must be >= 0; ";
   if (num_strands < 1 || num_strands > 200000) e << "num_strands must be in [1, 200000]; ";
   if (!(hair_root_diameter_m > 0 && hair_root_diameter_m < 0.01)) {
     e << "hair_root_diameter_m must be in (0, 0.01); ";
@@ -150,6 +152,9 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   // The set is written into a hidden folder of output_path and its parts moved into place once
   // all are written: a run that fails (a full disk, a bad strands file) leaves no half set that
   // the next run would refuse.
+  if (!options.strands_path.empty()) {
+    RequireDir(options.strands_path, "strands folder (--strands_path: a data set's gt/)");
+  }
   StagingDir staging(options.output_path, "synthesize");
 
   // Hair.

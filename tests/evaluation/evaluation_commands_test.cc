@@ -681,6 +681,23 @@ TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
   std::filesystem::remove_all(scene.dir);
 }
 
+// Noise beyond a metre (or infinite, which wrote infinite depths) and even median windows are
+// refused by name.
+TEST(EvaluationCommands, ImportOptionsAreChecked) {
+  ImportGroundTruthOptions options;
+  std::string error;
+  EXPECT_TRUE(options.Check(&error)) << error;
+  for (double noise : {-1e-3, 2.0, std::numeric_limits<double>::infinity()}) {
+    options.noise_m = noise;
+    EXPECT_FALSE(options.Check(&error)) << noise;
+    EXPECT_NE(error.find("--noise_m must be in [0, 1]"), std::string::npos) << error;
+  }
+  options = ImportGroundTruthOptions();
+  options.median_filter_px = 8;
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("--median_filter_px"), std::string::npos) << error;
+}
+
 TEST(EvaluationCommands, ImportRefusesToWriteIntoItsInputs) {
   const Scene scene = MakeScene("refuse");
   EXPECT_THROW(ImportGroundTruth(scene.gt, scene.workspace, JoinPaths(scene.workspace, "x"),

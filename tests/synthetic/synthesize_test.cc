@@ -53,6 +53,21 @@ TEST(Synthesize, OptionsAreChecked) {
   options.num_groups = 9;
   EXPECT_FALSE(options.Check(&error));
   EXPECT_THROW(RunSynthesize(options), Error);
+  options.num_groups = 1;
+  options.seed = -1;  // taken as unsigned, it was quietly 2^64 - 1
+  EXPECT_FALSE(options.Check(&error));
+  EXPECT_NE(error.find("seed must be >= 0"), std::string::npos) << error;
+  // A missing strands folder is named as the option's, not as a ground truth folder.
+  options.seed = 1;
+  options.output_path = MakeTestDir("missing_strands");
+  options.strands_path = JoinPaths(options.output_path, "no_such_gt");
+  try {
+    RunSynthesize(options);
+    ADD_FAILURE() << "a missing --strands_path was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--strands_path"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(Exists(JoinPaths(options.output_path, "dense")));
   HairStyle style;
   EXPECT_TRUE(FromString("curly", &style));
   EXPECT_EQ(style, HairStyle::kCurly);
