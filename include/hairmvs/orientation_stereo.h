@@ -655,9 +655,9 @@ struct OrientationStereoResult {
 
 // Computes depth maps for `image_names` (empty: every image of the workspace). `device_spec`
 // picks the OpenCL device ("" = first GPU, else first CPU; an index; or a name substring).
-// `source_views` chooses the source views (null: SourceViewOptions' defaults, 4 views); an
+// `source_views` chooses the source views (null: SourceViewOptions' defaults, 6 views); an
 // explicit patch-match.cfg list is capped to its max_num_source_views. `field_options` (null:
-// the defaults, the paper's filter) computes the orientation fields that are not cached in
+// OrientationFieldOptions' defaults) computes the orientation fields that are not cached in
 // stereo/orientation_maps/ with these options (its num_levels is replaced by
 // options.PyramidLevels()).
 // Throws hairmvs::Error for bad input (unknown image, missing files, bad options).
