@@ -65,6 +65,7 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
     const std::string image_path = JoinPaths(images, image.name);
     THROW_IF(!ExistsFile(image_path), "Image " << image.name << " is listed in the model "
                                                << sparse << " but missing: " << image_path);
+    ws.image_id_by_name_.emplace(image.name, id);  // unique: ReadReconstruction checks it
     ws.image_names_.push_back(image.name);
   }
   if (!mask_path.empty()) {
@@ -177,10 +178,10 @@ std::vector<std::string> Workspace::SelectImages(
 }
 
 const Image& Workspace::ImageByName(const std::string& name) const {
-  const Image* image = model_.FindImageByName(name);
-  THROW_IF(image == nullptr,
+  const auto it = image_id_by_name_.find(name);
+  THROW_IF(it == image_id_by_name_.end(),
            "Image with name `" << name << "` does not exist in workspace " << path_);
-  return *image;
+  return model_.images.at(it->second);
 }
 
 const Camera& Workspace::CameraOf(const std::string& name) const {

@@ -4,7 +4,9 @@
 // normal_maps/), optional masks (<mask_path>/<image name>.png, 0 = excluded).
 // hairmvs adds stereo/orientation_maps/ and stereo/confidence_maps/ in the same naming.
 
+#include <cstdint>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "colmap_ext/reconstruction.h"
@@ -90,6 +92,8 @@ class Workspace {
   std::string mask_path_;
   Reconstruction model_;
   std::vector<std::string> image_names_;
+  // The model's image_id of each name (ImageByName without a search through the model).
+  std::unordered_map<std::string, uint32_t> image_id_by_name_;
 };
 
 // Images as float maps, for the dense stages. Throws hairmvs::Error naming the file.
