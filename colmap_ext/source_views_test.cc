@@ -311,7 +311,8 @@ TEST(SourceViews, ViewsLookingTheSameWayAreWithinTheAngleOfTheReferencesAxis) {
   EXPECT_EQ(ViewsLookingTheSameWay(ws, "d.png", {}, 65),
             (std::vector<std::string>{"a.png", "b.png", "c.png", "e.png"}));
   // Views already chosen (the sources) are not repeated.
-  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {"b.png"}, 50), (std::vector<std::string>{"c.png"}));
+  EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {"b.png"}, 50),
+            (std::vector<std::string>{"c.png"}));
   EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 10), (std::vector<std::string>{}));
   EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 180).size(), 4u);
 }

@@ -19,7 +19,8 @@ struct WorkspaceInfoViewRow {
   std::string mask_path;  // "" = none
   double mask_keep_fraction = -1;  // share of pixels the mask keeps; -1 = no mask or unusable
   std::string mask_error;  // why the mask cannot be used (all zero, another aspect ratio)
-  std::string image_error;  // why the image cannot be used (unreadable, cut short, not its camera's size)
+  // Why the image cannot be used (unreadable, cut short, not its camera's size).
+  std::string image_error;
   DepthRange depth_range;
 };
 

@@ -85,8 +85,10 @@ struct OrientationFieldOptions {
   void ForEachField(Visitor&& v) {
     v("num_levels", &num_levels, "number of pyramid levels (2x2 box downsampling)");
     v("num_orientations", &num_orientations, "number of filter angles in [0, pi)");
-    v("sigma_across_inner_px", &sigma_across_inner_px, "inner (positive) Gaussian across the strand");
-    v("sigma_across_outer_px", &sigma_across_outer_px, "outer (negative) Gaussian across the strand");
+    v("sigma_across_inner_px", &sigma_across_inner_px,
+      "inner (positive) Gaussian across the strand");
+    v("sigma_across_outer_px", &sigma_across_outer_px,
+      "outer (negative) Gaussian across the strand");
     v("sigma_along_px", &sigma_along_px, "Gaussian along the strand");
     v("confidence_gamma", &confidence_gamma, "F = (max |response|)^gamma");
     v("truncation_sigmas", &truncation_sigmas,

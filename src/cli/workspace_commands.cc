@@ -70,7 +70,8 @@ int RunWorkspaceInfo(int argc, char** argv) {
   if (!parser.Parse(argc, argv)) return 0;
   std::string error;
   THROW_IF(!field_options.Check(&error), "invalid --OrientationField options: " << error);
-  THROW_IF(!stereo_options.Check(&error), "invalid --max_image_size: " << error);  // its one stereo option
+  // max_image_size is its one stereo option.
+  THROW_IF(!stereo_options.Check(&error), "invalid --max_image_size: " << error);
   Timer timer;
   const WorkspaceInfo info = ComputeWorkspaceInfo(workspace_path, mask_path, options);
   stereo_options.mask_path = mask_path;  // the fields' provenance names the masks

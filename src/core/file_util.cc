@@ -234,9 +234,9 @@ bool ProcessEnded(long pid) {
 }
 
 // ".<stem>.tmp<pid>_<n>_<token>@<host tag><extension>" beside `path`: hidden, unique to this
-// process (ProcessToken), with the process and HostTag that a later run needs to tell whether it was left
-// by a run that was killed (RemoveTemporariesOfEndedRuns), and with the extension kept (OpenCV
-// picks the image format by it). The stem is shortened where the name would pass the file
+// process (ProcessToken), with the process and HostTag that a later run needs to tell whether it
+// was left by a run that was killed (RemoveTemporariesOfEndedRuns), and with the extension kept
+// (OpenCV picks the image format by it). The stem is shortened where the name would pass the file
 // system's 255-byte limit, which a long name near it otherwise would.
 std::string TemporaryPathFor(const std::string& path) {
   static std::atomic<int> counter{0};
@@ -257,8 +257,9 @@ std::string TemporaryPathFor(const std::string& path) {
 }
 
 // The process of this host (and PID namespace: HostTag) that made the temporary file `name`
-// (TemporaryPathFor), or -1 for a name of another or no temporary's. A name of the older form without token and host,
-// ".<stem>.tmp<pid>_<n><extension>", counts as this host's, as ScratchDir's do.
+// (TemporaryPathFor), or -1 for a name of another or no temporary's. A name of the older form
+// without token and host, ".<stem>.tmp<pid>_<n><extension>", counts as this host's, as
+// ScratchDir's do.
 long TemporaryOwnerOnThisHost(const std::string& name, const std::string& host) {
   static const std::regex kCurrent(R"(\..*\.tmp([0-9]{1,9})_[0-9]+_[0-9a-f]{8})");
   static const std::regex kOlder(R"(\..*\.tmp([0-9]{1,9})_[0-9]+)");

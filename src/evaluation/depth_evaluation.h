@@ -1,7 +1,7 @@
 #pragma once
-// EvaluateDepthMaps and EvaluateMesh with the true strands' index built by the caller (tests and tools that
-// evaluate several workspaces of one data set index the strands once: ~25 s for 40 000 strands
-// at 0.2 mm).
+// EvaluateDepthMaps and EvaluateMesh with the true strands' index built by the caller (tests and
+// tools that evaluate several workspaces of one data set index the strands once: ~25 s for 40 000
+// strands at 0.2 mm).
 
 #include <string>
 

@@ -125,7 +125,9 @@ Graph BuildGraph(const FusionMesh& mesh, const TemplateFusionOptions& options, d
   std::map<std::array<int64_t, 3>, std::vector<int>> voxels;
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {
     std::array<int64_t, 3> key;
-    for (int k = 0; k < 3; ++k) key[k] = static_cast<int64_t>(std::floor(mesh.vertices[i][k] / spacing));
+    for (int k = 0; k < 3; ++k) {
+      key[k] = static_cast<int64_t>(std::floor(mesh.vertices[i][k] / spacing));
+    }
     voxels[key].push_back(static_cast<int>(i));
   }
   Graph graph;
@@ -263,9 +265,9 @@ RegistrationStats RefineTemplate(const std::vector<FusionView>& views,
     }
     const double rigid_scale = std::sqrt(rigidity_weight / graph.nodes.size());
     for (auto& p : params) {
-      problem.AddResidualBlock(
-          new ceres::AutoDiffCostFunction<RigidityCost, 6, kNodeParams>(new RigidityCost(rigid_scale)),
-          nullptr, p.data());
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<RigidityCost, 6, kNodeParams>(
+                                   new RigidityCost(rigid_scale)),
+                               nullptr, p.data());
     }
     if (!graph.edges.empty()) {
       const double smooth_scale =

@@ -14,7 +14,8 @@ class PointKdTree {
   PointKdTree& operator=(const PointKdTree&) = delete;
   explicit PointKdTree(std::vector<Eigen::Vector3d> points)
       : adaptor_{std::move(points)},
-        index_(std::make_unique<Index>(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(16))) {
+        index_(
+            std::make_unique<Index>(3, adaptor_, nanoflann::KDTreeSingleIndexAdaptorParams(16))) {
     index_->buildIndex();
   }
   size_t Size() const { return adaptor_.points.size(); }

@@ -36,9 +36,11 @@ FloatMap ResizeNearest(const FloatMap& map, int width, int height) {
   FloatMap out(width, height, map.Channels());
   for (int c = 0; c < map.Channels(); ++c) {
     for (int row = 0; row < height; ++row) {
-      const int r = std::min(map.Height() - 1, static_cast<int>((row + 0.5) * map.Height() / height));
+      const int r =
+          std::min(map.Height() - 1, static_cast<int>((row + 0.5) * map.Height() / height));
       for (int col = 0; col < width; ++col) {
-        const int k = std::min(map.Width() - 1, static_cast<int>((col + 0.5) * map.Width() / width));
+        const int k =
+            std::min(map.Width() - 1, static_cast<int>((col + 0.5) * map.Width() / width));
         out.At(row, col, c) = map.At(r, k, c);
       }
     }
@@ -167,7 +169,8 @@ FusionOutput FuseViews(const std::vector<FusionView>& views, const TemplateFusio
     int iterations = 0;
     double edge = out.coarse.MeanEdgeLength();
     size_t num_vertices = out.coarse.vertices.size();
-    while (edge > target_edge && num_vertices * 4 <= static_cast<size_t>(options.max_mesh_vertices)) {
+    while (edge > target_edge &&
+           num_vertices * 4 <= static_cast<size_t>(options.max_mesh_vertices)) {
       edge *= 0.5;
       num_vertices *= 4;
       ++iterations;

@@ -71,7 +71,8 @@ OpenCLDeviceInfo DescribeDevice(int index, const cl::Platform& platform, const c
 }
 
 bool IsNumber(const std::string& s) {
-  return !s.empty() && std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
+  return !s.empty() &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isdigit(c); });
 }
 
 void ResolveIncludesInText(const std::string& file, const std::string& text,
@@ -205,10 +206,14 @@ std::shared_ptr<OpenCLContext> OpenCLContext::Create(const std::string& device_s
   int chosen = -1;
   if (spec.empty()) {
     for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
-      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) chosen = static_cast<int>(i);
+      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_GPU) {
+        chosen = static_cast<int>(i);
+      }
     }
     for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
-      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) chosen = static_cast<int>(i);
+      if (devices[i].second.getInfo<CL_DEVICE_TYPE>() & CL_DEVICE_TYPE_CPU) {
+        chosen = static_cast<int>(i);
+      }
     }
     if (chosen < 0) chosen = 0;
   } else if (IsNumber(spec)) {
@@ -222,9 +227,9 @@ std::shared_ptr<OpenCLContext> OpenCLContext::Create(const std::string& device_s
   } else {
     const std::string needle = ToLower(spec);
     for (size_t i = 0; i < devices.size() && chosen < 0; ++i) {
-      const std::string name = ToLower(StripWhitespace(devices[i].first.getInfo<CL_PLATFORM_NAME>()) +
-                                       " / " +
-                                       StripWhitespace(devices[i].second.getInfo<CL_DEVICE_NAME>()));
+      const std::string name =
+          ToLower(StripWhitespace(devices[i].first.getInfo<CL_PLATFORM_NAME>()) + " / " +
+                  StripWhitespace(devices[i].second.getInfo<CL_DEVICE_NAME>()));
       if (name.find(needle) != std::string::npos) chosen = static_cast<int>(i);
     }
     THROW_IF(chosen < 0, "--OpenCL.device '" << spec

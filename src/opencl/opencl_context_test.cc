@@ -100,7 +100,8 @@ TEST(OpenCLContext, EmbeddedFilesBuild) {
 TEST(OpenCLContext, BuildFailureThrowsWithLog) {
   auto context = OpenCLContext::Create();
   try {
-    context->ProgramFromSource("__kernel void broken(__global float* x) { x[0] = undefined_name; }");
+    context->ProgramFromSource(
+        "__kernel void broken(__global float* x) { x[0] = undefined_name; }");
     FAIL() << "expected a build failure";
   } catch (const Error& e) {
     const std::string what = e.what();

@@ -79,7 +79,8 @@ OrientationFilterBank::OrientationFilterBank(const OrientationFieldOptions& opti
         // response varies by well under 1% within a few degrees of its maximum.
         // Squares whose centre is more than 0.71 px (half a diagonal) outside cannot reach in.
         const double centre_along = dx * c + dy * s, centre_across = -dx * s + dy * c;
-        if (std::abs(centre_along) > max_along + 0.71 || std::abs(centre_across) > max_across + 0.71)
+        if (std::abs(centre_along) > max_along + 0.71 ||
+            std::abs(centre_across) > max_across + 0.71)
           continue;
         Sample sample{dx, dy, 0.0, 0.0};
         int inside = 0;

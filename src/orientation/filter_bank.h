@@ -45,7 +45,7 @@ struct BlockedFilterBank {
   int block_size = 0;
   int num_blocks = 0;        // ceil(num_orientations / block_size); the last is zero-padded
   int num_orientations = 0;
-  std::vector<int> tap_begin;     // num_blocks + 1 entries: taps of block b are [begin[b], begin[b+1])
+  std::vector<int> tap_begin;  // num_blocks + 1 entries: taps of block b are [begin[b], begin[b+1])
   std::vector<int> tap_dx, tap_dy;  // one offset of each pair (dy > 0, or dy == 0 and dx >= 0)
   std::vector<float> weights;     // [tap][block_size]
 };

@@ -46,8 +46,8 @@ struct VisualHullRangeOptions {
 // Per pixel of the reference (every options.pixel_step-th column and row inside its mask), the
 // first stretch of its ray inside the hull: a 2-channel map (near, far) in metres at the
 // reference's size, (0, 0) where not sampled or where the ray never enters the hull. The near
-// end is a lower bound on the depth of whatever the pixel sees: the first surface along the ray lies
-// inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
+// end is a lower bound on the depth of whatever the pixel sees: the first surface along the ray
+// lies inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
 // phantom stretch of hull, carved by no view, may lie in front of the surface.) The ends are
 // refined by bisection between the depth samples; the far ends only with
 // options.find_far_ends.

@@ -217,7 +217,9 @@ inline FloatMap Downsample2x2(const FloatMap& in) {
 
 inline std::vector<FloatMap> Pyramid(const FloatMap& level0, int num_levels) {
   std::vector<FloatMap> levels = {level0};
-  while (static_cast<int>(levels.size()) < num_levels) levels.push_back(Downsample2x2(levels.back()));
+  while (static_cast<int>(levels.size()) < num_levels) {
+    levels.push_back(Downsample2x2(levels.back()));
+  }
   return levels;
 }
 

@@ -67,8 +67,9 @@ HairStrands HairFromStrands(const HeadModel& head, std::vector<Eigen::Vector3f> 
                             std::vector<int64_t> offsets, uint64_t seed);
 
 // Strands resampled along their uniform Catmull-Rom splines (end points repeated, as the
-// evaluation's StrandDistance and Blender do: p_{-1} = p_0), every stored point kept, at most `max_spacing_m` apart; with the
-// tube radius of each point (linear in the stored index from root to tip).
+// evaluation's StrandDistance and Blender do: p_{-1} = p_0), every stored point kept, at most
+// `max_spacing_m` apart; with the tube radius of each point (linear in the stored index from root
+// to tip).
 struct DenseStrands {
   std::vector<Eigen::Vector3f> points;
   std::vector<float> radius_m;

@@ -206,8 +206,8 @@ TEST(HairScene, CrossViewConsistency) {
     EXPECT_GT(same_strand, 0.9 * visible) << ToString(style);
     EXPECT_GT(map_checked, 20);
     // Curls bend within a pixel or two, where the linear slope bound above is loose.
-    EXPECT_GE(map_agree, (style == HairStyle::kCurly ? 0.85 : 0.98) * map_checked) << ToString(style) << " " << map_agree << " of "
-                                             << map_checked;
+    EXPECT_GE(map_agree, (style == HairStyle::kCurly ? 0.85 : 0.98) * map_checked)
+        << ToString(style) << " " << map_agree << " of " << map_checked;
     RecordProperty("max_tube_error_m", std::to_string(max_tube_error));
   }
 }

@@ -142,10 +142,10 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
 TEST(Cli, PipelineEvaluatesTheMapsItsStereoWrote) {
   const std::string dir = testing_util::MakeTestDir("cli_pipeline");
   const std::string workspace = SynthesizeSmallSet(dir);
-  CommandOutput output = RunHairmvs("pipeline --workspace_path " + workspace + " --ground_truth_path " +
-                      JoinPaths(dir, "gt") + " --stages orientation,stereo" +
-                      " --OrientationStereo.geom_consistency 0" +
-                      " --OrientationStereo.single_pass_type photometric");
+  CommandOutput output = RunHairmvs(
+      "pipeline --workspace_path " + workspace + " --ground_truth_path " + JoinPaths(dir, "gt") +
+      " --stages orientation,stereo --OrientationStereo.geom_consistency 0" +
+      " --OrientationStereo.single_pass_type photometric");
   ASSERT_EQ(output.exit_code, 0) << output.text;
   EXPECT_TRUE(ExistsFile(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png.photometric.bin")));
   EXPECT_FALSE(ExistsFile(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png.geometric.bin")));

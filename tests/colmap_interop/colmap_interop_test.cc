@@ -430,7 +430,8 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
   // runs, where colmap would abort with a stack trace.
   const std::string mapper_output = JoinPaths(dir, "mapper_output");
   WriteReconstruction(model, JoinPaths(mapper_output, "0"), ModelFormat::kText);
-  error = ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, mapper_output, workspace); });
+  error =
+      ErrorOf([&] { RunImageUndistorter(ColmapExecutable(), photos, mapper_output, workspace); });
   EXPECT_NE(error.find("found a sub-folder 0/"), std::string::npos) << error;
   EXPECT_EQ(FolderEntries(out), nothing);
 
