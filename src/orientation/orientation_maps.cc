@@ -11,6 +11,8 @@
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
 #include "src/core/option_parser.h"
+#include "src/core/timer.h"
+#include "src/orientation/orientation_field.h"
 
 namespace hairmvs {
 namespace {
@@ -246,6 +248,20 @@ void WriteOrientationFields(const Workspace& workspace, const std::string& name,
   files.push_back({provenance_path, [&recorded](std::ostream& out) { out << recorded; },
                    /*binary=*/false});
   WriteFilesAtomically(files, /*last_marks_complete=*/true);
+}
+
+std::vector<FloatMap> ComputeViewOrientationFields(const Workspace& workspace,
+                                                   const std::string& name, int max_image_size,
+                                                   OrientationFieldComputer* computer,
+                                                   StageTimings* timings) {
+  FloatMap gray, mask;
+  {
+    ScopedStageTimer timer(timings, "read image");
+    gray = workspace.ReadViewGray(name, max_image_size);
+    const std::string mask_path = workspace.MaskPath(name);
+    if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
+  }
+  return computer->Compute(gray, mask);
 }
 
 }  // namespace hairmvs

@@ -43,6 +43,19 @@ std::optional<std::vector<FloatMap>> ReadCachedOrientationFields(
     const Workspace& workspace, const std::string& name, const std::string& provenance,
     const StereoCamera& camera, int num_levels, std::string* why_not);
 
+class OrientationFieldComputer;  // src/orientation/orientation_field.h
+class StageTimings;              // src/core/timer.h
+
+// The fields of `name` that the cache does not hold, computed by `computer` (its options'
+// levels) from the image read at `max_image_size` and the view's mask (none where it has none):
+// the one way `hairmvs orientation_fields` and the stereo compute them, so that either's
+// fields are the other's to reuse. The image and mask are read under the stage "read image"
+// of `timings` (null: not timed apart).
+std::vector<FloatMap> ComputeViewOrientationFields(const Workspace& workspace,
+                                                   const std::string& name, int max_image_size,
+                                                   OrientationFieldComputer* computer,
+                                                   StageTimings* timings = nullptr);
+
 // Writes the levels of `name`, then its provenance, as one unit (WriteFilesAtomically with the
 // provenance marking it whole): the old provenance is removed before any level is replaced, so
 // that levels left half-replaced by an interrupted run are never reused.

@@ -130,15 +130,9 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
       levels = std::move(*cached);
       progress.Stage("up to date, pictures missing: writing them");
     } else {
-      FloatMap gray, mask;
-      {
-        ScopedStageTimer timer(timings, "read image");
-        gray = workspace.ReadViewGray(name, run_options.max_image_size);
-        const std::string mask_path = workspace.MaskPath(name);
-        if (!mask_path.empty()) mask = ReadMask(mask_path, gray.Width(), gray.Height());
-      }
       progress.Stage("filter bank");
-      levels = computer->Compute(gray, mask);
+      levels = ComputeViewOrientationFields(workspace, name, run_options.max_image_size,
+                                            computer.get(), timings);
       progress.Stage("write");
       ScopedStageTimer timer(timings, "write");
       WriteOrientationFields(workspace, name, provenance, levels);

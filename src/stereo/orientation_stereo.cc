@@ -403,12 +403,12 @@ class ViewLoader {
     if (cached) {
       data.orientation = std::move(*cached);
     } else {
-      const FloatMap gray = workspace_.ReadViewGray(name, options_.max_image_size);
-      const FloatMap mask = ReadMask(workspace_.MaskPath(name), w, h);
       if (!computer_) {
         computer_ = std::make_unique<OrientationFieldComputer>(context_, field_options);
       }
-      data.orientation = computer_->Compute(gray, mask);
+      // Under this stage's "orientation": the reading is not timed apart.
+      data.orientation = ComputeViewOrientationFields(workspace_, name, options_.max_image_size,
+                                                      computer_.get());
       if (options_.write_orientation_maps) {
         WriteOrientationFields(workspace_, name, provenance, data.orientation);
       }
