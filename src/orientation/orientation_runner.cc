@@ -130,7 +130,7 @@ OrientationFieldsResult RunOrientationFields(const std::string& workspace_path,
       levels = std::move(*cached);
       progress.Stage("up to date, pictures missing: writing them");
     } else {
-      progress.Stage("filter bank");
+      progress.Stage("read image, filter bank");
       levels = ComputeViewOrientationFields(workspace, name, run_options.max_image_size,
                                             computer.get(), timings);
       progress.Stage("write");

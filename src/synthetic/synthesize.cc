@@ -149,12 +149,12 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
              "synthesize: " << path << " exists already: give a new --output_path (or remove "
                             << "the old set first)");
   }
-  // The set is written into a hidden folder of output_path and its parts moved into place once
-  // all are written: a run that fails (a full disk, a bad strands file) leaves no half set that
-  // the next run would refuse.
   if (!options.strands_path.empty()) {
     RequireDir(options.strands_path, "strands folder (--strands_path: a data set's gt/)");
   }
+  // The set is written into a hidden folder of output_path and its parts moved into place once
+  // all are written: a run that fails (a full disk, a bad strands file) leaves no half set that
+  // the next run would refuse.
   StagingDir staging(options.output_path, "synthesize");
 
   // Hair.

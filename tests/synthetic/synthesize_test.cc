@@ -191,8 +191,13 @@ TEST(Synthesize, RendersGivenStrandsAsTheirOwnSet) {
   // Named as the option's folder, not as a ground truth folder the user never gave.
   EXPECT_NE(message.find("--strands_path"), std::string::npos) << message;
   EXPECT_NE(message.find(options.strands_path), std::string::npos) << message;
-  // The failed run leaves nothing (not even its hidden staging folder), so the same command
-  // with the right strands runs at once.
+  EXPECT_EQ(testing_util::NumEntriesIn(options.output_path), 0);
+  // A folder without the strands fails once the set's staging folder exists: the failed run
+  // leaves nothing (not even its hidden staging folder), so the same command with the right
+  // strands runs at once.
+  options.strands_path = MakeTestDir("strands_empty_gt");
+  const std::string empty_message = testing_util::ErrorOf([&] { RunSynthesize(options); });
+  EXPECT_NE(empty_message.find("strands_points.npy"), std::string::npos) << empty_message;
   EXPECT_EQ(testing_util::NumEntriesIn(options.output_path), 0);
   options.strands_path = gt_first;
   RunSynthesize(options);
