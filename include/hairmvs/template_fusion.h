@@ -46,8 +46,10 @@ struct TemplateFusionOptions {
   double trim_min_sample_spacings = 1.5;
   // Connected components with fewer faces than this fraction of the largest are dropped.
   double min_component_fraction = 0.05;
-  // Before refinement the template is subdivided (midpoint) until its mean edge is at most
-  // this many median pixel footprints, so the detail step has vertices to carry detail.
+  // Before refinement the template is subdivided (Loop: smooth, it draws a coarse template a
+  // little inside a convex surface, which the refinement's fit takes back) until its mean edge
+  // is at most this many median pixel footprints, so the detail step has vertices to carry
+  // detail.
   double target_edge_length_px = 3.0;
   // ... but the subdivided template keeps at most this many vertices.
   int max_mesh_vertices = 400000;
@@ -121,7 +123,8 @@ struct TemplateFusionOptions {
     v("max_detail_offset_cells", &max_detail_offset_cells, "max detail offset, octree cells");
     v("max_detail_view_angle_deg", &max_detail_view_angle_deg,
       "max angle between line of sight and vertex normal for detail");
-    v("num_threads", &num_threads, "threads for Poisson and Ceres");
+    v("num_threads", &num_threads,
+      "threads for the fused points, fit targets, Ceres and detail (Poisson runs on one)");
     v("write_intermediate", &write_intermediate, "also write the coarse and refined templates");
   }
   bool Check(std::string* error) const;

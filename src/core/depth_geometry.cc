@@ -1,6 +1,7 @@
 #include "src/core/depth_geometry.h"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
 
 #include "src/core/logging.h"
@@ -64,6 +65,28 @@ StereoCamera StereoCamera::PyramidLevel(int level) const {
     scaled.height = (scaled.height + 1) / 2;
   }
   return scaled;
+}
+
+double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
+                      double max_slope) {
+  CHECK_EQ(depth.Channels(), 1);
+  if (!(x >= 0 && y >= 0 && x < depth.Width() && y < depth.Height())) return 0.0;
+  const double nearest = depth.At(static_cast<int>(y), static_cast<int>(x));
+  if (!(nearest > 0)) return 0.0;
+  // The four centres around (x, y): columns c0, c0 + 1 and rows r0, r0 + 1.
+  const double u = x - 0.5, v = y - 0.5;
+  const int c0 = static_cast<int>(std::floor(u)), r0 = static_cast<int>(std::floor(v));
+  if (c0 < 0 || r0 < 0 || c0 + 1 >= depth.Width() || r0 + 1 >= depth.Height()) return nearest;
+  const double d00 = depth.At(r0, c0), d01 = depth.At(r0, c0 + 1);
+  const double d10 = depth.At(r0 + 1, c0), d11 = depth.At(r0 + 1, c0 + 1);
+  const double lowest = std::min({d00, d01, d10, d11});
+  if (!(lowest > 0)) return nearest;
+  const double max_step = max_slope * lowest / focal;
+  const bool one_surface = std::abs(d00 - d01) <= max_step && std::abs(d10 - d11) <= max_step &&
+                           std::abs(d00 - d10) <= max_step && std::abs(d01 - d11) <= max_step;
+  if (!one_surface) return nearest;
+  const double a = u - c0, b = v - r0;
+  return (1 - b) * ((1 - a) * d00 + a * d01) + b * ((1 - a) * d10 + a * d11);
 }
 
 Eigen::Vector3d BackProjectPixelToWorld(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 #include <utility>
+#include <vector>
 
 #include "src/core/test_util.h"
 
@@ -156,6 +157,38 @@ TEST(DepthGeometry, NormalsFaceTheCameraAndStopAtDiscontinuities) {
   FloatMap spike(5, 5, 1, 3.0f);
   spike.At(2, 2) = 1.0f;
   EXPECT_EQ(NormalMapFromDepthMap(spike, K).At(2, 2, 2), 0.0f);
+}
+
+TEST(DepthGeometry, SampleDepthMapInterpolatesOneSurfaceOnly) {
+  const double focal = 100;
+  FloatMap ramp(12, 10, 1);
+  for (int r = 0; r < 10; ++r) {
+    for (int col = 0; col < 12; ++col) ramp.At(r, col) = 1.0f + 0.002f * col + 0.001f * r;
+  }
+  // Pixel centres at (col + 0.5, row + 0.5): bilinear is exact on a ramp.
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {3.5, 4.5}, {3.9, 4.2}, {7.01, 2.99}, {10.6, 8.4}}) {
+    EXPECT_NEAR(SampleDepthMap(ramp, x, y, focal), 1.0 + 0.002 * (x - 0.5) + 0.001 * (y - 0.5),
+                1e-6)
+        << x << " " << y;
+  }
+  // Within half a pixel of the border there are not four centres around: the pixel's depth.
+  EXPECT_FLOAT_EQ(SampleDepthMap(ramp, 0.2, 4.5, focal), ramp.At(4, 0));
+  EXPECT_FLOAT_EQ(SampleDepthMap(ramp, 11.8, 9.9, focal), ramp.At(9, 11));
+  // Off the map, or where the pixel has no depth: 0; a missing neighbour: the pixel's depth.
+  EXPECT_EQ(SampleDepthMap(ramp, -0.1, 4.5, focal), 0.0);
+  EXPECT_EQ(SampleDepthMap(ramp, 12.0, 4.5, focal), 0.0);
+  FloatMap holed = ramp;
+  holed.At(4, 4) = 0;
+  EXPECT_EQ(SampleDepthMap(holed, 4.2, 4.7, focal), 0.0);
+  EXPECT_FLOAT_EQ(SampleDepthMap(holed, 3.9, 4.7, focal), holed.At(4, 3));
+  // A step between two layers (0.5 m, far steeper than max_slope): never blended.
+  FloatMap step(12, 10, 1, 1.0f);
+  for (int r = 0; r < 10; ++r) {
+    for (int col = 6; col < 12; ++col) step.At(r, col) = 1.5f;
+  }
+  EXPECT_FLOAT_EQ(SampleDepthMap(step, 5.9, 4.5, focal), 1.0f);
+  EXPECT_FLOAT_EQ(SampleDepthMap(step, 6.1, 4.5, focal), 1.5f);
 }
 
 }  // namespace

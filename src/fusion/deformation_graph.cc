@@ -192,11 +192,8 @@ std::vector<Eigen::Vector3d> FitTargets(const std::vector<FusionView>& views,
     int count = 0;
     for (size_t j = 0; j < views.size(); ++j) {
       if (n.dot(centers[j] - v) <= 0) continue;  // back-facing: the map sees the other side
-      int col, row;
-      double z;
-      if (!views[j].Project(v, &col, &row, &z)) continue;
-      const float d = views[j].depth.At(row, col);
-      if (!(d > 0)) continue;
+      double z, d;
+      if (!views[j].DepthOnRay(v, &z, &d)) continue;
       const Eigen::Vector3d q = views[j].SurfaceOnRay(v, z, d);
       if ((q - v).norm() > max_distance_m) continue;  // another layer, or an occluder
       sum += q;

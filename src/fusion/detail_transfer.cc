@@ -25,11 +25,8 @@ DetailStats TransferDetail(const std::vector<FusionView>& views,
     std::vector<double> s;
     for (size_t j = 0; j < views.size(); ++j) {
       if (normal.dot((centers[j] - v).normalized()) < min_cos) continue;
-      int col, row;
-      double z;
-      if (!views[j].Project(v, &col, &row, &z)) continue;
-      const float d = views[j].depth.At(row, col);
-      if (!(d > 0)) continue;
+      double z, d;
+      if (!views[j].DepthOnRay(v, &z, &d)) continue;
       const double offset = (views[j].SurfaceOnRay(v, z, d) - v).dot(normal);
       if (std::abs(offset) <= max_offset) s.push_back(offset);
     }

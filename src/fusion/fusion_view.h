@@ -20,7 +20,9 @@ struct FusionView {
   Eigen::Matrix3d R = Eigen::Matrix3d::Identity();
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
   FloatMap depth;   // z-depth on the pixel grid, 0 = invalid
-  FloatMap normal;  // 3 channels, camera-frame unit normals facing the camera; empty = from depth
+  // 3 channels, camera-frame unit normals facing the camera; FuseViews needs them
+  // (RunTemplateFusion computes them from the depth where the workspace has no normal map).
+  FloatMap normal;
   FloatMap rgb;     // 3 channels (R, G, B) in [0, 1]; empty = grey
 
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
@@ -33,11 +35,21 @@ struct FusionView {
   Eigen::Vector3d BackProject(int col, int row, double z) const {
     return BackProjectPixelToWorld(K, R, t, col, row, z);
   }
-  // The point of this map's surface on the line of sight through `world` (the depth of the
-  // pixel it projects to, along its own ray): how the map "sees" that point.
-  Eigen::Vector3d SurfaceOnRay(const Eigen::Vector3d& world, double z, float map_depth) const {
+  // The point of this map's surface on the line of sight through `world`, whose own z-depth
+  // is `z`, given the map's depth there: how the map "sees" that point.
+  Eigen::Vector3d SurfaceOnRay(const Eigen::Vector3d& world, double z, double map_depth) const {
     const Eigen::Vector3d c = Center();
     return c + (world - c) * (map_depth / z);
+  }
+  // The map's depth where the line of sight through `world` meets it (SampleDepthMap at the
+  // point's exact image position) and the point's own z-depth: false behind the camera, off
+  // the map or where the map has no depth there.
+  bool DepthOnRay(const Eigen::Vector3d& world, double* z, double* map_depth) const {
+    const Eigen::Vector3d x = K * (R * world + t);
+    if (!(x.z() > 0)) return false;
+    *z = x.z();
+    *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), K(0, 0));
+    return *map_depth > 0;
   }
   Eigen::Vector3d WorldNormalAt(int row, int col) const {
     const Eigen::Vector3d n_cam(normal.At(row, col, 0), normal.At(row, col, 1),

@@ -109,6 +109,27 @@ TEST(TemplateFusion, NormalsThatCancelOutAreAnError) {
   EXPECT_NE(error.find("the depth maps' normals cancel out"), std::string::npos) << error;
 }
 
+// Exact, aligned depth maps: the Poisson template already lies on the sphere, and the
+// refinement and the detail must keep it there. Each view's depth is read where a vertex
+// projects, between the pixel centres: the depth of the pixel it lands in, taken along the
+// vertex's own ray up to half a pixel away, moved vertices along the slope on the sphere's
+// flanks (mean error 0.00025 -> 0.0026 -> 0.0033, max 0.026, before SampleDepthMap).
+TEST(TemplateFusion, ExactSphereStaysOnTheSurface) {
+  testing::SceneOptions scene;
+  const testing::Sdf sdf = testing::SphereSdf(1.0);
+  const std::vector<FusionView> views = testing::RenderViews(sdf, scene);
+  const FusionOutput out = FuseViews(views, TestOptions(), nullptr);
+  const SurfaceError coarse = ErrorToSurface(sdf, out.coarse);
+  const SurfaceError refined = ErrorToSurface(sdf, out.refined);
+  const SurfaceError final_error = ErrorToSurface(sdf, out.final_mesh);
+  std::cerr << "exact sphere error (mean/max): coarse " << coarse.mean << "/" << coarse.max
+            << ", refined " << refined.mean << "/" << refined.max << ", final "
+            << final_error.mean << "/" << final_error.max << "\n";
+  EXPECT_LT(refined.mean, 0.002);
+  EXPECT_LT(final_error.mean, 0.001);
+  EXPECT_LT(final_error.max, 0.005);
+}
+
 TEST(TemplateFusion, NoisyMisalignedSphereIsOneGenusZeroSurface) {
   testing::SceneOptions scene;
   scene.depth_noise = 0.005;
