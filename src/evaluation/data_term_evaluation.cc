@@ -98,10 +98,23 @@ bool LabelPosition(const std::vector<double>& depths, double depth, double* posi
   return false;
 }
 
-// The first pixel of a grid of `fine_size` whose centre lies in pixel `coarse` of a grid of
-// `coarse_size` over the same image, or beyond (SfM convention: the grids share their edges).
-int FirstFinePixel(int coarse, int fine_size, int coarse_size) {
-  return static_cast<int>(std::ceil(static_cast<double>(coarse) * fine_size / coarse_size - 0.5));
+// The first pixel of a fine grid whose centre lies in pixel `coarse` of a grid `scale` times
+// coarser over the same image, or beyond (SfM convention: the grids start at the same edge).
+int FirstFinePixel(int coarse, double scale) {
+  return static_cast<int>(std::ceil(coarse * scale - 0.5));
+}
+
+// The camera of a cost volume's grid: a level of the stereo's image pyramid
+// (StereoCamera::PyramidLevel, whose image coordinates halve exactly, so that for an odd size
+// the grid reaches past the image and is not the image scaled to the grid's size), or, for a
+// volume of no level of the image (a run with a max_image_size), the image scaled to it.
+StereoCamera VolumeGridCamera(const StereoCamera& view_camera, int width, int height,
+                              const std::string& volume_path) {
+  for (int level = 0; level < 16; ++level) {  // 2^16: past any image
+    const StereoCamera grid = view_camera.PyramidLevel(level);
+    if (grid.width == width && grid.height == height) return grid;
+  }
+  return view_camera.ScaledToMap(width, height, volume_path);
 }
 
 // The samples of one view: its volume against the true depths. Each true hair depth is
@@ -128,14 +141,17 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
       }
     }
   }
+  // Truth pixels per grid pixel: the truth's image is the workspace's at its own size.
+  const double scale_x = truth_camera.K(0, 0) / grid_camera.K(0, 0);
+  const double scale_y = truth_camera.K(1, 1) / grid_camera.K(1, 1);
   std::vector<float> costs(num_labels);
   for (int r = 0; r < ch; ++r) {
     // The image pixels whose centres fall into coarse pixel (r, c).
-    const int row_begin = std::max(0, FirstFinePixel(r, gt_height, ch));
-    const int row_end = std::min(gt_height, FirstFinePixel(r + 1, gt_height, ch));
+    const int row_begin = std::max(0, FirstFinePixel(r, scale_y));
+    const int row_end = std::min(gt_height, FirstFinePixel(r + 1, scale_y));
     for (int c = 0; c < cw; ++c) {
-      const int col_begin = std::max(0, FirstFinePixel(c, gt_width, cw));
-      const int col_end = std::min(gt_width, FirstFinePixel(c + 1, gt_width, cw));
+      const int col_begin = std::max(0, FirstFinePixel(c, scale_x));
+      const int col_end = std::min(gt_width, FirstFinePixel(c + 1, scale_x));
       const int covered = std::max(0, row_end - row_begin) * std::max(0, col_end - col_begin);
       const std::vector<double>& hair_depths = cell_depths[static_cast<size_t>(r) * cw + c];
       if (covered == 0 || hair_depths.empty() ||
@@ -217,8 +233,8 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
             : view_camera.ScaledToMap(gt_width, gt_height,
                                       GroundTruthViewPath(ground_truth_path, name));
     EvaluateView(volume, gt, truth_camera,
-                 view_camera.ScaledToMap(volume.cost.Width(), volume.cost.Height(),
-                                         ws.CostVolumePath(name)),
+                 VolumeGridCamera(view_camera, volume.cost.Width(), volume.cost.Height(),
+                                  ws.CostVolumePath(name)),
                  options.min_hair_fraction, &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);

@@ -32,6 +32,10 @@ struct DepthSamples {
   // depth - true depth of the hair pixels with a depth, near the silhouette or not.
   std::vector<double> silhouette_errors_m, interior_errors_m;
   std::vector<double> distances_3d_m;  // a subset of them, back-projected
+  // How many pixels with a depth each of distances_3d_m stands for (its view's count over its
+  // sample's, DepthEvaluationOptions::max_points_3d_per_view), so that pooled views weigh
+  // by their pixels as in the other columns.
+  std::vector<double> distance_weights;
   std::vector<double> layers;          // of the pixels whose true depth window is all hair
   // The signed errors' smooth part and the rest (DepthEvaluationOptions::smooth_error_window_px).
   std::vector<double> smooth_errors_m, rough_errors_m;
@@ -42,6 +46,7 @@ struct DepthSamples {
     for (auto [to, from] : {std::pair(&silhouette_errors_m, &other.silhouette_errors_m),
                             std::pair(&interior_errors_m, &other.interior_errors_m),
                             std::pair(&distances_3d_m, &other.distances_3d_m),
+                            std::pair(&distance_weights, &other.distance_weights),
                             std::pair(&smooth_errors_m, &other.smooth_errors_m),
                             std::pair(&rough_errors_m, &other.rough_errors_m)}) {
       to->insert(to->end(), from->begin(), from->end());
@@ -56,33 +61,37 @@ double MedianMm(const std::vector<double>& values_m) {
 }
 
 // Where the ray of `true_camera`'s pixel (col, row) meets the depth map `depth` of `camera`
-// (the workspace's, whose pose may differ from the true one): from `start_depth` on, each step
-// takes the map's depth at the pixel where the ray's point projects, and moves along the ray to
-// that depth's z in the true camera, at most four steps: the two cameras being a fraction of a
-// degree apart, the pixel met settles in one or two (a step that meets the previous step's
-// pixel would repeat it, so the walk stops there), and at a depth edge, where it may alternate
-// between two pixels, the last is taken. `*world` is the map's point met, `*true_depth` its z
-// in the true camera. False where the ray meets a pixel without a depth or leaves the map.
+// (the workspace's, whose pose may differ from the true one, and whose map may be smaller than
+// the truth): from `start_depth` on, each step takes the map's depth where the ray's point
+// projects (SampleDepthMap: between the map's pixel centres, which a smaller map puts on the
+// truth's pixel edges) and moves along the ray to the point at that depth in the map's camera,
+// at most four steps: the two cameras being a fraction of a degree apart, it settles in one or
+// two (in one where they are the same camera), and at a depth edge, where it may alternate
+// between two pixels, the last is taken. `*world` is the point met, `*true_depth` its z in the
+// true camera. False where the ray meets no depth or leaves the map.
 bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
                        const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
                        double* true_depth) {
+  // The ray's point of z-depth z in the true camera, origin + z direction, has the z-depth
+  // offset + z slope in the map's camera.
+  const Eigen::Vector3d origin = true_camera.Center();
+  const Eigen::Vector3d direction = true_camera.BackProject(col, row, 1.0) - origin;
+  const double offset = (camera.R * origin + camera.t).z();
+  const double slope = (camera.R * direction).z();
+  if (!(slope > 0)) return false;
   double z = start_depth;
-  int previous_col = -1, previous_row = -1;
   for (int step = 0; step < 4; ++step) {
-    int map_col = 0, map_row = 0;
-    double map_z = 0;
-    if (!camera.Project(true_camera.BackProject(col, row, z), &map_col, &map_row, &map_z)) {
-      return false;
-    }
-    if (map_col == previous_col && map_row == previous_row) break;  // settled
-    previous_col = map_col;
-    previous_row = map_row;
-    const float d = depth.At(map_row, map_col);
-    if (!(d > 0)) return false;
-    *world = camera.BackProject(map_col, map_row, d);
-    z = (true_camera.R * *world + true_camera.t).z();
-    if (!(z > 0)) return false;
+    const Eigen::Vector3d x = camera.K * (camera.R * (origin + z * direction) + camera.t);
+    if (!(x.z() > 0)) return false;
+    const double map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), camera.K(0, 0));
+    if (!(map_depth > 0)) return false;
+    const double next = (map_depth - offset) / slope;
+    if (!(next > 0)) return false;
+    const bool settled = std::abs(next - z) <= 1e-9 * z;
+    z = next;
+    if (settled) break;
   }
+  *world = origin + z * direction;
   *true_depth = z;
   return true;
 }
@@ -158,7 +167,8 @@ DepthMetrics Summarize(const std::string& name, const DepthSamples& samples) {
   m.median_layer = Percentile(samples.layers, 0.5);
   m.smooth_median_abs_error_mm = MedianMm(Absolute(samples.smooth_errors_m));
   m.rough_median_abs_error_mm = MedianMm(Absolute(samples.rough_errors_m));
-  const DistanceStats accuracy = SummarizeDistances(samples.distances_3d_m);
+  const DistanceStats accuracy =
+      SummarizeDistances(samples.distances_3d_m, samples.distance_weights);
   m.num_points_3d = accuracy.count;
   m.accuracy_3d_mean_mm = accuracy.mean_mm;
   m.accuracy_3d_median_mm = accuracy.median_mm;
@@ -301,13 +311,13 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
     const int gt_width = gt.depth.Width(), gt_height = gt.depth.Height();
     const StereoCamera camera =
         ws.ViewCamera(name).ScaledToMap(width, height, ws.DepthMapPath(name, options.depth_type));
-    // In the true camera, at the map's size: each of its hair pixels is compared where its ray
-    // meets the map (DepthAlongTrueRay), so that every true hair pixel counts once, with a
-    // depth or without.
+    // In the true camera: each true hair pixel sampled is compared where the ray through its
+    // centre meets the map (DepthAlongTrueRay), so that every one counts once, with a depth or
+    // without. (Through the truth's pixel, not the map's: a map of half the size has its pixel
+    // centres on the truth's pixel edges.)
     std::optional<StereoCamera> true_camera;
     if (options.in_true_cameras) {
-      true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
-                        .Scaled(width, height);
+      true_camera = TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height);
     }
 
     // Distance (gt pixels) of each gt pixel to the nearest background pixel; the band in
@@ -346,8 +356,8 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
         bool has_estimate = compared_depth > 0;
         if (true_camera) {
           const double start = has_estimate ? compared_depth : gt.depth.At(gr, gc);
-          has_estimate = start > 0 && DepthAlongTrueRay(*true_camera, c, r, start, camera, depth,
-                                                        &world, &compared_depth);
+          has_estimate = start > 0 && DepthAlongTrueRay(*true_camera, gc, gr, start, camera,
+                                                        depth, &world, &compared_depth);
         } else if (has_estimate) {
           world = camera.BackProject(c, r, compared_depth);
         }
@@ -378,8 +388,10 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
         points.push_back(world);
       }
     }
+    double weight_3d = 1;
     if (options.max_points_3d_per_view > 0 &&
         points.size() > static_cast<size_t>(options.max_points_3d_per_view)) {
+      weight_3d = static_cast<double>(points.size()) / options.max_points_3d_per_view;
       std::shuffle(points.begin(), points.end(), rng);
       points.resize(options.max_points_3d_per_view);
     }
@@ -390,6 +402,7 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
     laps.Lap("per-pixel errors");
     progress.Stage("3D distances");
     samples.distances_3d_m = strand_distance.Distances(points);
+    samples.distance_weights.assign(samples.distances_3d_m.size(), weight_3d);
     result.views.push_back(Summarize(name, samples));
     laps.Lap("3D distances");
 

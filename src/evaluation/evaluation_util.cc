@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
+#include <utility>
 
 #include "src/core/file_util.h"
 #include "src/core/logging.h"
@@ -38,6 +40,44 @@ DistanceStats SummarizeDistances(std::vector<double> distances_m) {
   stats.median_mm = 1e3 * (n % 2 ? distances_m[n / 2]
                                  : 0.5 * (distances_m[n / 2 - 1] + distances_m[n / 2]));
   stats.p90_mm = 1e3 * distances_m[std::min(n - 1, static_cast<size_t>(0.9 * (n - 1) + 0.5))];
+  return stats;
+}
+
+DistanceStats SummarizeDistances(std::vector<double> distances_m,
+                                 const std::vector<double>& weights) {
+  CHECK_EQ(distances_m.size(), weights.size());
+  if (std::adjacent_find(weights.begin(), weights.end(), std::not_equal_to<>()) ==
+      weights.end()) {
+    return SummarizeDistances(std::move(distances_m));
+  }
+  std::vector<size_t> order(distances_m.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return distances_m[a] < distances_m[b]; });
+  // cumulative[i]: the weight of the i + 1 smallest distances. As copies, the i-th smallest
+  // distance holds the copy indices [cumulative[i - 1], cumulative[i]).
+  std::vector<double> cumulative(order.size());
+  double total = 0, weighted_sum = 0;
+  for (size_t i = 0; i < order.size(); ++i) {
+    const double w = weights[order[i]];
+    CHECK_GT(w, 0.0);
+    total += w;
+    weighted_sum += w * distances_m[order[i]];
+    cumulative[i] = total;
+  }
+  auto at_copy = [&](double index) {
+    const size_t i = std::upper_bound(cumulative.begin(), cumulative.end(), index) -
+                     cumulative.begin();
+    return distances_m[order[std::min(i, order.size() - 1)]];
+  };
+  // SummarizeDistances' rules, over the copies: the median the mean of the middle two of an
+  // even count, the 90th percentile the copy at the rounded index.
+  const double middle = 0.5 * (total - 1);
+  DistanceStats stats;
+  stats.count = static_cast<long>(distances_m.size());
+  stats.mean_mm = 1e3 * weighted_sum / total;
+  stats.median_mm = 1e3 * 0.5 * (at_copy(std::floor(middle)) + at_copy(std::ceil(middle)));
+  stats.p90_mm = 1e3 * at_copy(std::floor(0.9 * (total - 1) + 0.5));
   return stats;
 }
 

@@ -21,6 +21,11 @@ std::vector<double> Absolute(std::vector<double> values);
 
 // Mean, median and 90th percentile of distances given in metres, reported in mm.
 DistanceStats SummarizeDistances(std::vector<double> distances_m);
+// The same where each distance stands for `weights[i]` (> 0) copies of itself (a sample of
+// each view's pixels, pooled over views of different sizes): the figures of the copies, by
+// SummarizeDistances' rules. Equal weights give SummarizeDistances' figures exactly.
+DistanceStats SummarizeDistances(std::vector<double> distances_m,
+                                 const std::vector<double>& weights);
 // Percentile q in [0, 1] (nearest rank on the sorted values); NaN for an empty vector.
 double Percentile(std::vector<double> values, double q);
 double Mean(const std::vector<double>& values);
