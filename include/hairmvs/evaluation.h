@@ -77,7 +77,8 @@ struct DepthEvaluationOptions {
   bool write_error_images = true;
   // Colour scale of the error pictures: 0 (blue) to this (red), in mm.
   double error_image_max_mm = 10.0;
-  // 3D accuracy from at most this many randomly chosen pixels per view (0 = all).
+  // 3D accuracy from at most this many randomly chosen pixels per view (0 = all); in the
+  // overall row each view's sample stands for all of its pixels with a depth.
   int max_points_3d_per_view = 0;
   int seed = 0;
   // Spline sampling of the true strands (StrandDistance): distances are to the polyline through
@@ -107,10 +108,12 @@ struct DepthEvaluationOptions {
   // the map's own finer errors. The medians of both are reported. 31 px: about the reach of the
   // coarsest level's aggregation window at 960 x 640. 0: not computed.
   int smooth_error_window_px = 31;
-  // Where a depth is compared with the truth. On: in the view's true camera (gt/cameras.npz,
-  // at the map's size), each true hair pixel is compared with the map where its ray meets it:
-  // the map's point there, back-projected with the workspace's camera, as a z-depth in the true
-  // camera; a true hair pixel whose ray meets no depth is missing. So every true hair pixel
+  // Where a depth is compared with the truth. On: in the view's true camera (gt/cameras.npz;
+  // where the map is smaller, the true pixel each map pixel's centre lies in), each true hair
+  // pixel is compared with the map where the ray through its centre meets it: the ray's point
+  // at the map's depth there in the workspace's camera (read between the map's pixel centres,
+  // SampleDepthMap), as a z-depth in the true camera; a true hair pixel whose ray meets no
+  // depth is missing. So every true hair pixel
   // counts once, as the same index does, rather than wherever the map's depths happen to
   // land. Off: every depth is compared with the true
   // pixel of the same index. The two are the same where the workspace's cameras are the true
@@ -199,7 +202,9 @@ DepthEvaluationResult EvaluateDepthMaps(const std::string& workspace_path,
 // The data term alone, without the MRF: per coarse pixel of a view's cost volume as
 // `orientation_stereo --OrientationStereo.write_cost_volume 1` writes it, where its cheapest
 // label lies against the true depth (the median true depth of the hair pixels the coarse pixel
-// covers). Compares costs (orientation vs photometric) on what they bring, before smoothing.
+// covers; the volume's grid is a level of the stereo's image pyramid, whose image coordinates
+// halve exactly, so that for an odd size it reaches past the image). Compares costs
+// (orientation vs photometric) on what they bring, before smoothing.
 struct DataTermEvaluationOptions {
   // Empty: every image of the workspace that has a cost volume.
   std::vector<std::string> image_names;
