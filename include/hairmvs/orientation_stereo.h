@@ -250,19 +250,24 @@ struct OrientationStereoOptions {
   // with strand_plane_from_visual_hull): synth_handheld 60.2 -> 74.5% of the hair, per-pixel
   // median 6.22 -> 5.85 mm, mean 13.31 -> 11.67, 3D mean 3.17 -> 2.62 mm; synth_straight_gantry
   // g2 group 4.22 -> 4.03 mm; the curly demo group 2.36 -> 2.35 mm (its one T group's hull is
-  // long: the labels reach the hair all the same). Outside the reference's mask, where the
-  // hull has no bound, the labels count from the nearest pixel's bound (since stop 55; they
-  // counted from the range's front there, so that the hair's costs the aggregation carries
-  // beside the mask read as depths far in front of the hair, which the coarse MRF and the
-  // upsampling carried into the hair's edge). Measured (scripts/evaluate_stereo.sh, complete /
-  // per-pixel mean / median / 3D mean / 3D median, before -> after): synth_straight_gantry
-  // 98.7% / 7.93 / 4.17 / 1.018 / 0.524 -> 98.7% / 7.87 / 4.16 / 0.982 / 0.516 mm,
-  // synth_handheld 93.0% / 9.78 / 4.69 / 1.169 / 0.550 -> 92.7% / 9.90 / 4.75 / 1.289 / 0.546,
-  // the curly demo group 98.2% / 3.46 / 2.31 / 0.289 / 0.241 -> 98.6% / 3.61 / 2.35 / 0.277 /
-  // 0.236: the front pull had partly offset the silhouettes' lean behind (the demo's silhouette
-  // band 4.40 -> 4.68 mm, signed +2.08 -> +2.93), but on a strand sphere whose field stops at
-  // the mask (src/stereo/depth_estimator_test.cc) it left 60% of the hair within 3 px of the
-  // mask's edge with a depth, 73 mm off (now 100%, 8 mm).
+  // long: the labels reach the hair all the same).
+  // Outside the reference's mask, where the hull has no bound, the labels count from the
+  // range's front (VisualHullLabelBase: base 0), so that there the hair's costs, which the
+  // aggregation carries beside the mask, read as depths far in front of the hair. Counting them
+  // from the nearest pixel's bound instead (found by a review at stop 55, measured on 0e931bc
+  // and reverted; scripts/evaluate_stereo.sh, complete / per-pixel mean / median / 3D mean /
+  // 3D median, base 0 -> nearest bound): a strand sphere whose field stops at the mask (a test
+  // of 0e931bc) 60.5% of the hair within 3 px of the mask's edge with a depth at 73 mm -> 100%
+  // at 8 mm, but synth_straight_gantry 98.7% / 7.93 / 4.17 / 1.018 / 0.524 -> 98.7% / 7.87 /
+  // 4.16 / 0.982 / 0.516, synth_handheld 93.0% / 9.78 / 4.69 / 1.169 / 0.550 -> 92.7% / 9.90 /
+  // 4.75 / 1.289 / 0.546, the curly demo group 98.2% / 3.46 / 2.31 / 0.289 / 0.241 -> 98.6% /
+  // 3.61 / 2.35 / 0.277 / 0.236 (its silhouette band 4.40 -> 4.68 mm, signed +2.08 -> +2.93:
+  // the front pull had offset part of the silhouettes' lean behind), and the colour cost on
+  // synth_handheld 87.1% / 13.46 / 5.60 -> 83.9% / 17.41 / 6.30 mm (its data term alone 15.19
+  // -> 19.35 mm, signed +8.2 -> +14.9): the colour cost, unlike the orientation cost (whose
+  // field is 0 outside the mask), costs the background too, and with consistent labels the
+  // room behind the hair, matched at its own depth, pulls the hair's edge behind. Worth taking
+  // up with the colour cost masked as the orientation cost is.
   bool coarse_labels_from_visual_hull = true;
   // With coarse_labels_from_visual_hull: the coarse stage's smoothness compares how far behind
   // the hull's bound neighbouring pixels lie (a surface parallel to the hull's costs nothing)

@@ -149,38 +149,10 @@ void PenalizeInFrontOfBound(const std::vector<float>& bound_label,
   }
 }
 
-// `bound_labels0` (width0 x height0, -inf = none) with every pixel without a bound given the
-// bound of the nearest pixel with one (all -inf where none has one). The hull's bound exists
-// only within the reference's mask, but the coarse labels of the pixels beside it must count
-// from a bound too: the aggregation carries the hair's costs, counted from the hair's bound,
-// into them, and read from 0 there the same cheapest label k meant absolute label k, far in
-// front of the hair, which the MRF and the upsampling then carried into the hair's edge.
-std::vector<float> NearestBoundEverywhere(const std::vector<float>& bound_labels0, int width0,
-                                          int height0) {
-  cv::Mat missing(height0, width0, CV_8UC1);
-  for (int p = 0; p < width0 * height0; ++p) {
-    missing.data[p] = std::isfinite(bound_labels0[p]) ? 0 : 1;
-  }
-  if (cv::countNonZero(missing) == width0 * height0) return bound_labels0;
-  // Each pixel's nearest zero of `missing` (a pixel with a bound), by label.
-  cv::Mat distance, nearest;
-  cv::distanceTransform(missing, distance, nearest, cv::DIST_L2, cv::DIST_MASK_5,
-                        cv::DIST_LABEL_PIXEL);
-  std::vector<float> bound_of_label(static_cast<size_t>(width0) * height0 + 1, 0.0f);
-  for (int p = 0; p < width0 * height0; ++p) {
-    if (!missing.data[p]) bound_of_label[nearest.ptr<int>()[p]] = bound_labels0[p];
-  }
-  std::vector<float> filled = bound_labels0;
-  for (int p = 0; p < width0 * height0; ++p) {
-    if (missing.data[p]) filled[p] = bound_of_label[nearest.ptr<int>()[p]];
-  }
-  return filled;
-}
-
 // The coarse stage's first label at the pixels of pyramid level `level` (width x height) when
 // its labels start at the visual hull: the depth bound's label (`bound_labels0`, level-0 grid
-// width0 x height0, NearestBoundEverywhere's) at the level pixel's NearestLevel0Pixel; 0 where
-// there is none. At most the label from which num_labels labels end at 10 x depth_max, only so that the
+// width0 x height0, -inf = none) at the level pixel's NearestLevel0Pixel; 0 where there is
+// none. At most the label from which num_labels labels end at 10 x depth_max, only so that the
 // band's depths stay finite in inverse depth (labels past the range's far end cost time, not
 // accuracy: an estimate there is filtered as outside the range).
 std::vector<float> VisualHullLabelBase(const std::vector<float>& bound_labels0, int width0,
@@ -528,12 +500,10 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   if (progress != nullptr) progress->Stage("cost volume and aggregation (all depths)");
   const bool coarse_from_hull =
       options.coarse_labels_from_visual_hull && !visual_hull_entry.Empty();
-  const std::vector<float> coarse_bound0 =
-      coarse_from_hull ? NearestBoundEverywhere(bound0, width0, height0) : std::vector<float>();
   std::vector<std::vector<float>> coarse_base(num_pyramid_levels);
   for (int l = 0; l < num_pyramid_levels; ++l) {
     coarse_base[l] = coarse_from_hull
-                         ? VisualHullLabelBase(coarse_bound0, width0, height0, labels, l,
+                         ? VisualHullLabelBase(bound0, width0, height0, labels, l,
                                                levels[l].width, levels[l].height)
                          : std::vector<float>(
                                static_cast<size_t>(levels[l].width) * levels[l].height, 0.0f);

@@ -7,9 +7,6 @@
 #include <cmath>
 #include <functional>
 
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
 #include "hairmvs/orientation_fields.h"
 #include "src/opencl/opencl_context.h"
 #include "src/stereo/stereo_test_util.h"
@@ -324,90 +321,6 @@ TEST(DepthEstimator, CoarseLabelsFromTheVisualHullFollowTheSphere) {
   EXPECT_LT(along.median_abs_error_m, 0.6 * fronto_parallel.median_abs_error_m);
   EXPECT_GT(along.completeness, 0.5);
   EXPECT_NE(along.fine_energy, tight.fine_energy);
-}
-
-// The visual hull's bound exists only within the reference's mask (a cap of the sphere
-// here, its field 0 elsewhere, as a masked photo's), but the aggregation carries the hair's
-// costs, counted behind the hair's bound, into the pixels beside the mask. Their coarse labels
-// must count from a bound too: counted from depth_min there, the same cheapest offset was a
-// depth far in front of the hair, which the coarse MRF and the upsampling carried into the
-// hair's edge (before NearestBoundEverywhere, within 3 px of the mask's edge: 60.5% of the hair
-// pixels with a depth, 73 mm median error; now 100%, 8 mm).
-TEST(DepthEstimator, HairAtTheMasksEdgeIsNotPulledInFrontByTheBackground) {
-  Surface sphere;
-  sphere.sphere = true;
-  sphere.point = {0, 0, 1.2};
-  sphere.radius = 0.45;
-  const std::vector<StereoCamera> cameras = TCameras({0, 0, 1});
-  const int width = cameras[0].width, height = cameras[0].height;
-  const auto strands = MakeStrands(sphere, 900, 0.9, 0.25, 2);
-  std::vector<StereoViewData> views;
-  FloatMap true_depth;
-  for (const StereoCamera& camera : cameras) {
-    const testing_util::RenderedView view = RenderView(camera, sphere, strands);
-    if (true_depth.Empty()) true_depth = view.depth;
-    views.push_back({camera, Pyramid(view.orientation, 3), {}, {}});
-  }
-  // The mask: the cap of the sphere facing the reference, within 0.6 of its axis.
-  FloatMap mask(width, height, 1, 0.0f);
-  cv::Mat background(height, width, CV_8UC1, cv::Scalar(0));
-  const Eigen::Matrix3d K_inverse = cameras[0].K.inverse();
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) {
-      const float d = true_depth.At(r, c);
-      const Eigen::Vector3d n = d * (K_inverse * Eigen::Vector3d(c + 0.5, r + 0.5, 1)) -
-                                sphere.point;
-      const bool cap = d > 0 && std::hypot(n.x(), n.y()) <= 0.6 * sphere.radius;
-      if (cap) mask.At(r, c) = 1.0f;
-      background.at<uint8_t>(r, c) = cap ? 255 : 0;
-    }
-  }
-  for (size_t level = 0; level < views[0].orientation.size(); ++level) {
-    FloatMap& field = views[0].orientation[level];
-    const int scale = 1 << level;
-    for (int r = 0; r < field.Height(); ++r) {
-      for (int c = 0; c < field.Width(); ++c) {
-        const int r0 = std::min(height - 1, r * scale + scale / 2);
-        const int c0 = std::min(width - 1, c * scale + scale / 2);
-        if (mask.At(r0, c0) > 0) continue;
-        field.At(r, c, 0) = 0.0f;
-        field.At(r, c, 1) = 0.0f;
-      }
-    }
-  }
-  // The hull's entry 20 mm in front of the cap, and nowhere else.
-  FloatMap hull_entry(width, height, 1, 0.0f);
-  for (size_t p = 0; p < mask.Data().size(); ++p) {
-    if (mask.Data()[p] > 0) hull_entry.Data()[p] = true_depth.Data()[p] - 0.02f;
-  }
-  cv::Mat distance_to_background;
-  cv::distanceTransform(background, distance_to_background, cv::DIST_L2, cv::DIST_MASK_PRECISE);
-  OrientationStereoOptions options = TestOptions();
-  options.window_px_level0 = 15;
-  options.window_px_level2 = 7;
-  auto context = OpenCLContext::Create();
-  const DepthEstimate estimate =
-      EstimateDepthMap(context.get(), views[0], {&views[1], &views[2], &views[3]}, mask,
-                       hull_entry, DepthLabels(0.6, 1.4, options.num_depths, true), options,
-                       nullptr);
-  std::vector<double> edge_errors;
-  int edge_pixels = 0;
-  for (int r = 0; r < height; ++r) {
-    for (int c = 0; c < width; ++c) {
-      if (!(mask.At(r, c) > 0) || distance_to_background.at<float>(r, c) > 3) continue;
-      ++edge_pixels;
-      const float d = estimate.depth.At(r, c);
-      if (d > 0) edge_errors.push_back(std::abs(d - true_depth.At(r, c)));
-    }
-  }
-  ASSERT_GT(edge_pixels, 100);
-  std::sort(edge_errors.begin(), edge_errors.end());
-  const double with_depth = static_cast<double>(edge_errors.size()) / edge_pixels;
-  const double median_m = edge_errors.empty() ? 1.0 : edge_errors[edge_errors.size() / 2];
-  std::printf("hair within 3 px of the mask's edge: %.1f%% with a depth, median |error| %.4f m\n",
-              100 * with_depth, median_m);
-  EXPECT_GT(with_depth, 0.9);
-  EXPECT_LT(median_m, 0.02);
 }
 
 // Check() refuses `options`, naming `option` in its message.
