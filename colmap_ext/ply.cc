@@ -345,8 +345,8 @@ void WriteFusedVis(std::ostream& out, const std::vector<FusedPoint>& points) {
 void WriteFusedPly(const std::string& ply_path, const std::vector<FusedPoint>& points) {
   // One unit: COLMAP's mesher CHECK-fails on a .vis of another point count than the PLY's.
   // The .ply last, marking the pair whole: a run stopped between the renames leaves no
-  // fused.ply rather than a new one beside an old .vis of another point count (which COLMAP's
-  // poisson_mesher would refuse).
+  // fused.ply rather than a new one beside an old .vis of another point count (which `colmap
+  // delaunay_mesher --input_type dense` reads with it).
   WriteFilesAtomically(
       {{ply_path + ".vis", [&](std::ostream& out) { WriteFusedVis(out, points); }},
        {ply_path, [&](std::ostream& out) { WriteFusedPlyPoints(out, points); }}},

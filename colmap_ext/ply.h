@@ -24,7 +24,9 @@ struct FusedPoint {
 // Writes `ply_path` (binary little-endian, x y z nx ny nz float, red green blue uchar: 27
 // bytes per vertex, COLMAP's exact header) and `ply_path` + ".vis" (uint64 N, then per point
 // uint32 M and M uint32 image_idx), as one unit (WriteFilesAtomically, the .ply marking it
-// complete): if either write fails, both old files are left as they were.
+// complete): if either write fails, both old files are left as they were; once both are
+// written the old .ply is removed first, so that a run stopped between the renames leaves
+// no .ply (to be made again), never a new one beside the old .vis.
 void WriteFusedPly(const std::string& ply_path, const std::vector<FusedPoint>& points);
 // Reads any PLY whose vertex element has x y z (float or double), optionally nx ny nz and
 // red/green/blue (or r/g/b, diffuse_red...) in ascii, binary_little_endian or

@@ -67,6 +67,16 @@ StereoCamera StereoCamera::PyramidLevel(int level) const {
   return scaled;
 }
 
+namespace {
+
+// Whether neighbouring depths `a` and `b` (> 0), a pixel apart, lie on one surface: no steeper
+// than atan(max_slope) from fronto-parallel at `depth` seen with `focal` px.
+bool ContinuesSurface(double a, double b, double depth, double focal, double max_slope) {
+  return std::abs(a - b) <= max_slope * depth / focal;
+}
+
+}  // namespace
+
 double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
                       double max_slope) {
   CHECK_EQ(depth.Channels(), 1);
@@ -81,9 +91,11 @@ double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
   const double d10 = depth.At(r0 + 1, c0), d11 = depth.At(r0 + 1, c0 + 1);
   const double lowest = std::min({d00, d01, d10, d11});
   if (!(lowest > 0)) return nearest;
-  const double max_step = max_slope * lowest / focal;
-  const bool one_surface = std::abs(d00 - d01) <= max_step && std::abs(d10 - d11) <= max_step &&
-                           std::abs(d00 - d10) <= max_step && std::abs(d01 - d11) <= max_step;
+  const auto continues = [&](double a, double b) {
+    return ContinuesSurface(a, b, lowest, focal, max_slope);
+  };
+  const bool one_surface = continues(d00, d01) && continues(d10, d11) &&
+                           continues(d00, d10) && continues(d01, d11);
   if (!one_surface) return nearest;
   const double a = u - c0, b = v - r0;
   return (1 - b) * ((1 - a) * d00 + a * d01) + b * ((1 - a) * d10 + a * d11);
@@ -131,11 +143,10 @@ FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
   // Tangent along one image direction (dr, dc) at (r, c): central difference when both
   // neighbours continue the surface, one-sided when only one does, none otherwise.
   auto tangent = [&](int r, int c, double d, int dr, int dc, Eigen::Vector3d* t) {
-    const double max_jump = max_slope * d / focal;
     const double d_plus = depth_at(r + dr, c + dc);
     const double d_minus = depth_at(r - dr, c - dc);
-    const bool plus_ok = d_plus > 0 && std::abs(d_plus - d) <= max_jump;
-    const bool minus_ok = d_minus > 0 && std::abs(d_minus - d) <= max_jump;
+    const bool plus_ok = d_plus > 0 && ContinuesSurface(d_plus, d, d, focal, max_slope);
+    const bool minus_ok = d_minus > 0 && ContinuesSurface(d_minus, d, d, focal, max_slope);
     if (!plus_ok && !minus_ok) return false;
     const Eigen::Vector3d p_plus = plus_ok ? BackProjectPixel(K, c + dc, r + dr, d_plus)
                                            : BackProjectPixel(K, c, r, d);

@@ -30,7 +30,8 @@ bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Ei
 // The z-depth of a map at image point (x, y) (pixel (col, row) centred at (col + 0.5,
 // row + 0.5)): bilinear between the four pixel centres around (x, y) where all four have a
 // depth and continue one surface (each pair of neighbours within max_slope * depth / focal,
-// the rule of NormalMapFromDepthMap), else the depth of the pixel (x, y) lies in, so that a
+// the lowest of the four's depth: NormalMapFromDepthMap's rule), else the depth of the pixel
+// (x, y) lies in, so that a
 // silhouette or a step between layers is not blended. A point half a pixel off a centre on a
 // slanted surface then reads the surface's depth there, not its neighbour's. 0 off the map or
 // where that pixel has no depth.

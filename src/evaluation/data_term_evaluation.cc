@@ -106,25 +106,28 @@ int FirstFinePixel(int coarse, double scale) {
 
 // The camera of a cost volume's grid: a level of the stereo's image pyramid
 // (StereoCamera::PyramidLevel, whose image coordinates halve exactly, so that for an odd size
-// the grid reaches past the image and is not the image scaled to the grid's size), or, for a
-// volume of no level of the image (a run with a max_image_size), the image scaled to it.
-StereoCamera VolumeGridCamera(const StereoCamera& view_camera, int width, int height,
+// the grid reaches past the image and is not the image scaled to the grid's size). The pyramid
+// starts at `processing_camera`, the view's at the size the stereo ran at (its depth maps');
+// for a volume of no level of it, the image scaled to the volume's size.
+StereoCamera VolumeGridCamera(const StereoCamera& processing_camera, int width, int height,
                               const std::string& volume_path) {
   for (int level = 0; level < 16; ++level) {  // 2^16: past any image
-    const StereoCamera grid = view_camera.PyramidLevel(level);
+    const StereoCamera grid = processing_camera.PyramidLevel(level);
     if (grid.width == width && grid.height == height) return grid;
   }
-  return view_camera.ScaledToMap(width, height, volume_path);
+  return processing_camera.ScaledToMap(width, height, volume_path);
 }
 
 // The samples of one view: its volume against the true depths. Each true hair depth is
 // back-projected with `truth_camera` (the camera the truth was rendered with, or the
 // workspace's at the truth's size) and lands, as a z-depth in the workspace's camera of the
 // volume's grid, in one coarse pixel: the true depths of a coarse pixel are those of the image
-// pixels whose centres fall in it where the two cameras are the same.
+// pixels whose centres fall in it where the two cameras are the same. A coarse pixel covers
+// scale_x x scale_y of the truth's pixels.
 void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
                   const StereoCamera& truth_camera, const StereoCamera& grid_camera,
-                  double min_hair_fraction, DataTermSamples* samples) {
+                  double scale_x, double scale_y, double min_hair_fraction,
+                  DataTermSamples* samples) {
   const FloatMap& cost = volume.cost;
   const std::vector<double>& depths = volume.label_depths;
   const int cw = cost.Width(), ch = cost.Height(), num_labels = cost.Channels();
@@ -141,9 +144,6 @@ void EvaluateView(const CostVolume& volume, const GroundTruthView& gt,
       }
     }
   }
-  // Truth pixels per grid pixel: the truth's image is the workspace's at its own size.
-  const double scale_x = truth_camera.K(0, 0) / grid_camera.K(0, 0);
-  const double scale_y = truth_camera.K(1, 1) / grid_camera.K(1, 1);
   std::vector<float> costs(num_labels);
   for (int r = 0; r < ch; ++r) {
     // The image pixels whose centres fall into coarse pixel (r, c).
@@ -232,10 +232,25 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
             ? TrueCamera(true_cameras, ground_truth_path, name, gt_width, gt_height)
             : view_camera.ScaledToMap(gt_width, gt_height,
                                       GroundTruthViewPath(ground_truth_path, name));
-    EvaluateView(volume, gt, truth_camera,
-                 VolumeGridCamera(view_camera, volume.cost.Width(), volume.cost.Height(),
-                                  ws.CostVolumePath(name)),
-                 options.min_hair_fraction, &samples);
+    // The stereo's camera: the view's at the size of the depth maps the same run wrote, where
+    // there are any (a max_image_size makes both smaller), else at the image's.
+    StereoCamera processing_camera = view_camera;
+    for (const char* type : {"photometric", "geometric"}) {
+      const std::string map_path = ws.DepthMapPath(name, type);
+      if (!ExistsFile(map_path)) continue;
+      const MatShape shape = ReadMatShape(map_path);
+      processing_camera = view_camera.ScaledToMap(shape.width, shape.height, map_path);
+      break;
+    }
+    const StereoCamera grid_camera = VolumeGridCamera(
+        processing_camera, volume.cost.Width(), volume.cost.Height(), ws.CostVolumePath(name));
+    // Truth pixels per grid pixel: the truth's picture is the workspace's image at its own
+    // size (the true focal length may differ from the workspace's, a mapper's).
+    const StereoCamera view_at_truth = view_camera.Scaled(gt_width, gt_height);
+    EvaluateView(volume, gt, truth_camera, grid_camera,
+                 view_at_truth.K(0, 0) / grid_camera.K(0, 0),
+                 view_at_truth.K(1, 1) / grid_camera.K(1, 1), options.min_hair_fraction,
+                 &samples);
     result.views.push_back(Summarize(name, samples));
     pooled.Append(samples);
     laps.Lap("cheapest labels against the truth");

@@ -65,10 +65,11 @@ double MedianMm(const std::vector<double>& values_m) {
 // the truth): from `start_depth` on, each step takes the map's depth where the ray's point
 // projects (SampleDepthMap: between the map's pixel centres, which a smaller map puts on the
 // truth's pixel edges) and moves along the ray to the point at that depth in the map's camera,
-// at most four steps: the two cameras being a fraction of a degree apart, it settles in one or
-// two (in one where they are the same camera), and at a depth edge, where it may alternate
-// between two pixels, the last is taken. `*world` is the point met, `*true_depth` its z in the
-// true camera. False where the ray meets no depth or leaves the map.
+// at most four steps: where the two cameras are the same the first step is exact; a fraction of
+// a degree apart, each step shrinks the gap by the map's slope along the ray, and the fourth is
+// taken as it is (at a depth edge the steps may alternate between two pixels). `*world` is the
+// point met, `*true_depth` its z in the true camera. False where the ray meets no depth or
+// leaves the map.
 bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
                        const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
                        double* true_depth) {
@@ -83,7 +84,8 @@ bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double
   for (int step = 0; step < 4; ++step) {
     const Eigen::Vector3d x = camera.K * (camera.R * (origin + z * direction) + camera.t);
     if (!(x.z() > 0)) return false;
-    const double map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), camera.K(0, 0));
+    const double focal = 0.5 * (camera.K(0, 0) + camera.K(1, 1));
+    const double map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), focal);
     if (!(map_depth > 0)) return false;
     const double next = (map_depth - offset) / slope;
     if (!(next > 0)) return false;

@@ -46,6 +46,7 @@ DistanceStats SummarizeDistances(std::vector<double> distances_m) {
 DistanceStats SummarizeDistances(std::vector<double> distances_m,
                                  const std::vector<double>& weights) {
   CHECK_EQ(distances_m.size(), weights.size());
+  for (const double w : weights) CHECK(w > 0 && std::isfinite(w)) << "weight " << w;
   if (std::adjacent_find(weights.begin(), weights.end(), std::not_equal_to<>()) ==
       weights.end()) {
     return SummarizeDistances(std::move(distances_m));
@@ -60,7 +61,6 @@ DistanceStats SummarizeDistances(std::vector<double> distances_m,
   double total = 0, weighted_sum = 0;
   for (size_t i = 0; i < order.size(); ++i) {
     const double w = weights[order[i]];
-    CHECK_GT(w, 0.0);
     total += w;
     weighted_sum += w * distances_m[order[i]];
     cumulative[i] = total;

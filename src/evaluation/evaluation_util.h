@@ -23,7 +23,8 @@ std::vector<double> Absolute(std::vector<double> values);
 DistanceStats SummarizeDistances(std::vector<double> distances_m);
 // The same where each distance stands for `weights[i]` (> 0) copies of itself (a sample of
 // each view's pixels, pooled over views of different sizes): the figures of the copies, by
-// SummarizeDistances' rules. Equal weights give SummarizeDistances' figures exactly.
+// SummarizeDistances' rules (exactly so for whole weights; a fractional weight is a fraction
+// of a copy). Equal weights give SummarizeDistances' figures exactly.
 DistanceStats SummarizeDistances(std::vector<double> distances_m,
                                  const std::vector<double>& weights);
 // Percentile q in [0, 1] (nearest rank on the sorted values); NaN for an empty vector.

@@ -48,7 +48,7 @@ struct FusionView {
     const Eigen::Vector3d x = K * (R * world + t);
     if (!(x.z() > 0)) return false;
     *z = x.z();
-    *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), K(0, 0));
+    *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), 0.5 * (K(0, 0) + K(1, 1)));
     return *map_depth > 0;
   }
   Eigen::Vector3d WorldNormalAt(int row, int col) const {

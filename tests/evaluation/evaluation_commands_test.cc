@@ -283,6 +283,40 @@ TEST(EvaluationCommands, NoiseHolesAndHalfResolution) {
   }
 }
 
+// With --max_points_3d_per_view, each view's sample stands for its pixels in the overall 3D
+// figures: v0 keeps a tenth of its rows, 5 mm behind the truth, v1 all of them, exact. Counted
+// per sample, v0's 5 mm would weigh as much as all of v1.
+TEST(EvaluationCommands, Overall3DFiguresWeighEachViewByItsPixels) {
+  const Scene scene = MakeScene("weights");
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  const std::string v0 = Workspace::Read(out).DepthMapPath("v0.png");
+  FloatMap depth = ReadMat(v0);
+  for (int r = 0; r < kHeight; ++r) {
+    for (int c = 0; c < kWidth; ++c) {
+      float& d = depth.At(r, c);
+      if (d > 0) d = r % 10 == 0 ? d + 5e-3f : 0.0f;
+    }
+  }
+  WriteMat(v0, depth);
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.max_points_3d_per_view = 20;
+  const DepthEvaluationResult result = EvaluateDepthMaps(out, scene.gt, options);
+  ASSERT_EQ(result.views.size(), 2u);
+  double pixels = 0, weighted = 0;
+  for (const DepthMetrics& view : result.views) {
+    EXPECT_EQ(view.num_points_3d, 20) << view.name;
+    pixels += view.num_with_depth;
+    weighted += view.num_with_depth * view.accuracy_3d_mean_mm;
+  }
+  EXPECT_GT(result.views[0].accuracy_3d_mean_mm, 4.0);
+  EXPECT_LT(result.views[1].accuracy_3d_mean_mm, 0.06);
+  EXPECT_NEAR(result.overall.accuracy_3d_mean_mm, weighted / pixels, 1e-9);
+  EXPECT_LT(result.overall.accuracy_3d_mean_mm, 1.0);
+  // The median of the copies: v1's, the larger part.
+  EXPECT_LT(result.overall.accuracy_3d_median_mm, 0.06);
+}
+
 TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
   // v0's depths 3 mm behind the truth within 4 px of the background, 1 mm in front further in;
   // the distance to the nearest background pixel by brute force.
