@@ -648,13 +648,14 @@ TEST(EvaluationCommands, LayerOfTheDepthsAmongTheTrueDepthsAround) {
 // Writes a cost volume for v0 on a 16 x 12 grid (4 x 4 image pixels each) with labels 5 mm
 // apart from 0.45 m (label 10 = 0.5 m, v0's true depth everywhere: it looks straight at the
 // plane z = 0.5), whose cheapest label is `cheapest` at every pixel.
-void WriteShiftedVolume(const Scene& scene, int cheapest, double first_depth = 0.45) {
+void WriteShiftedVolume(const Scene& scene, int cheapest, double first_depth = 0.45,
+                        int width = 16, int height = 12) {
   CostVolume volume;
-  volume.cost = FloatMap(16, 12, 32);
+  volume.cost = FloatMap(width, height, 32);
   for (int k = 0; k < 32; ++k) {
     volume.label_depths.push_back(first_depth + 0.005 * k);
-    for (int r = 0; r < 12; ++r) {
-      for (int c = 0; c < 16; ++c) volume.cost.At(r, c, k) = (k - cheapest) * (k - cheapest);
+    for (int r = 0; r < height; ++r) {
+      for (int c = 0; c < width; ++c) volume.cost.At(r, c, k) = (k - cheapest) * (k - cheapest);
     }
   }
   const std::string volumes = JoinPaths(scene.workspace, "stereo", "cost_volumes");
@@ -719,6 +720,28 @@ TEST(EvaluationCommands, DataTermAtTheTruthAndShiftedFromIt) {
       EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions()).overall;
   EXPECT_NEAR(in_front.median_abs_error_mm, 20.0, 1e-6);
   EXPECT_NEAR(in_front.median_signed_error_mm, -20.0, 1e-6);
+
+  // A volume of pyramid level 5 (2 x 2): its coarse pixels span 32 x 32 image pixels from the
+  // image's corner, the lower ones reaching past its 48 rows (the image scaled to 2 x 2, as the
+  // grid was taken before stop 55, gives 32 x 24 and counts all four as half hair).
+  WriteShiftedVolume(scene, 10, 0.45, 2, 2);
+  long half_hair_level5 = 0;
+  for (int r = 0; r < 2; ++r) {
+    for (int c = 0; c < 2; ++c) {
+      int hair = 0, covered = 0;
+      for (int y = 32 * r; y < std::min(32 * r + 32, kHeight); ++y) {
+        for (int x = 32 * c; x < std::min(32 * c + 32, kWidth); ++x) {
+          hair += truth.label[y * kWidth + x] == kLabelHair;
+          ++covered;
+        }
+      }
+      half_hair_level5 += 2 * hair >= covered;
+    }
+  }
+  EXPECT_EQ(half_hair_level5, 2);
+  EXPECT_EQ(EvaluateDataTerm(scene.workspace, scene.gt, DataTermEvaluationOptions())
+                .overall.num_pixels,
+            half_hair_level5);
 
   // Labels from 0.6 m: every true depth lies outside them.
   WriteShiftedVolume(scene, 10, 0.6);
