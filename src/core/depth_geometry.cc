@@ -101,6 +101,17 @@ double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
   return (1 - b) * ((1 - a) * d00 + a * d01) + b * ((1 - a) * d10 + a * d11);
 }
 
+bool MapDepthOnRay(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                   const FloatMap& depth, const Eigen::Vector3d& world, double* z,
+                   double* map_depth) {
+  const Eigen::Vector3d x = K * (R * world + t);
+  if (!(x.z() > 0)) return false;
+  *z = x.z();
+  *map_depth =
+      SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), 0.5 * (K(0, 0) + K(1, 1)));
+  return *map_depth > 0;
+}
+
 Eigen::Vector3d BackProjectPixelToWorld(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R,
                                         const Eigen::Vector3d& t, double col, double row,
                                         double depth) {

@@ -31,12 +31,19 @@ bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Ei
 // row + 0.5)): bilinear between the four pixel centres around (x, y) where all four have a
 // depth and continue one surface (each pair of neighbours within max_slope * depth / focal,
 // the lowest of the four's depth: NormalMapFromDepthMap's rule), else the depth of the pixel
-// (x, y) lies in, so that a
-// silhouette or a step between layers is not blended. A point half a pixel off a centre on a
-// slanted surface then reads the surface's depth there, not its neighbour's. 0 off the map or
-// where that pixel has no depth.
+// (x, y) lies in, so that a silhouette or a step between layers is not blended. A point half a
+// pixel off a centre on a slanted surface then reads the surface's depth there, not its
+// neighbour's. 0 off the map or where that pixel has no depth.
 double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
                       double max_slope = 10.0);
+
+// Where the line of sight through a world point meets the depth map `depth` of the camera
+// X_cam = R X_world + t: the map's depth at the point's exact image position (SampleDepthMap,
+// focal the mean of K's two), and the point's own z-depth. False behind the camera, off the
+// map or where the map has no depth there.
+bool MapDepthOnRay(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                   const FloatMap& depth, const Eigen::Vector3d& world, double* z,
+                   double* map_depth);
 
 // Whether a w x h picture is one of width x height at another scale, to a pixel's rounding each
 // way: a depth map or mask that a max_image_size made smaller, not one of another aspect ratio.

@@ -73,21 +73,20 @@ double MedianMm(const std::vector<double>& values_m) {
 bool DepthAlongTrueRay(const StereoCamera& true_camera, int col, int row, double start_depth,
                        const StereoCamera& camera, const FloatMap& depth, Eigen::Vector3d* world,
                        double* true_depth) {
-  // The ray's point of z-depth z in the true camera, origin + z direction, has the z-depth
-  // offset + z slope in the map's camera.
+  // The ray's point of z-depth z in the true camera is origin + z direction; its z-depth in
+  // the map's camera grows by `slope` per unit of z.
   const Eigen::Vector3d origin = true_camera.Center();
   const Eigen::Vector3d direction = true_camera.BackProject(col, row, 1.0) - origin;
-  const double offset = (camera.R * origin + camera.t).z();
   const double slope = (camera.R * direction).z();
   if (!(slope > 0)) return false;
   double z = start_depth;
   for (int step = 0; step < 4; ++step) {
-    const Eigen::Vector3d x = camera.K * (camera.R * (origin + z * direction) + camera.t);
-    if (!(x.z() > 0)) return false;
-    const double focal = 0.5 * (camera.K(0, 0) + camera.K(1, 1));
-    const double map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), focal);
-    if (!(map_depth > 0)) return false;
-    const double next = (map_depth - offset) / slope;
+    double point_depth = 0, map_depth = 0;
+    if (!MapDepthOnRay(camera.K, camera.R, camera.t, depth, origin + z * direction, &point_depth,
+                       &map_depth)) {
+      return false;
+    }
+    const double next = z + (map_depth - point_depth) / slope;
     if (!(next > 0)) return false;
     const bool settled = std::abs(next - z) <= 1e-9 * z;
     z = next;

@@ -45,11 +45,7 @@ struct FusionView {
   // point's exact image position) and the point's own z-depth: false behind the camera, off
   // the map or where the map has no depth there.
   bool DepthOnRay(const Eigen::Vector3d& world, double* z, double* map_depth) const {
-    const Eigen::Vector3d x = K * (R * world + t);
-    if (!(x.z() > 0)) return false;
-    *z = x.z();
-    *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), 0.5 * (K(0, 0) + K(1, 1)));
-    return *map_depth > 0;
+    return MapDepthOnRay(K, R, t, depth, world, z, map_depth);
   }
   Eigen::Vector3d WorldNormalAt(int row, int col) const {
     const Eigen::Vector3d n_cam(normal.At(row, col, 0), normal.At(row, col, 1),
