@@ -171,7 +171,13 @@ struct OrientationStereoOptions {
   // divided by the same filter's response to the hair indicator (floored at 0.1 / 0.3; a
   // prototype on af0af88, not kept) did not help: the g2 group 98.6% / 6.17 / 4.07 mm and
   // 99.0% / 6.15 / 4.05 mm against 99.6% / 6.07 / 4.02, the silhouette band 6.09 / 5.98 mm
-  // against 5.89, the interior 2.96 mm either way.
+  // against 5.89, the interior 2.96 mm either way. Nor did shiftable windows (a prototype at
+  // stop 56, after the guided filter each slice's minimum over the windows within r px: the
+  // cheapest window that still holds the pixel, so that a window on two layers may move onto
+  // one, the classic remedy for windows that straddle a depth step): r = half / all of the
+  // window's radius, the g2 group 99.1% / 6.20 / 4.08 and 98.5% / 6.32 / 4.17 mm against 99.6%
+  // / 6.07 / 4.02, the interior's lean -2.20 / -2.29 mm against -2.14: the cheapest window
+  // favours the front layer's continuous strands further.
   int window_px_level0 = 15;
   int window_px_level1 = 11;
   int window_px_level2 = 7;
@@ -266,8 +272,13 @@ struct OrientationStereoOptions {
   // synth_handheld 87.1% / 13.46 / 5.60 -> 83.9% / 17.41 / 6.30 mm (its data term alone 15.19
   // -> 19.35 mm, signed +8.2 -> +14.9): the colour cost, unlike the orientation cost (whose
   // field is 0 outside the mask), costs the background too, and with consistent labels the
-  // room behind the hair, matched at its own depth, pulls the hair's edge behind. Worth taking
-  // up with the colour cost masked as the orientation cost is.
+  // room behind the hair, matched at its own depth, pulls the hair's edge behind. Masking the
+  // colour cost as the orientation cost is (a prototype at stop 56: each level's colour cost
+  // set to 0 where the reference's field is 0, before the aggregation) does not change that:
+  // synth_handheld's colour cost with base 0, masked, 86.6% / 13.41 / 5.61 / 1.943 / 0.560
+  // (unmasked 87.1% / 13.46 / 5.60 / 2.018 / 0.563), with the nearest bound, masked, 84.4% /
+  // 17.28 / 6.35 / 2.484 / 0.566, its data term alone 19.65 mm, signed +15.3: the background
+  // lies inside the NCC windows of the hair's edge pixels themselves, not only beside them.
   bool coarse_labels_from_visual_hull = true;
   // With coarse_labels_from_visual_hull: the coarse stage's smoothness compares how far behind
   // the hull's bound neighbouring pixels lie (a surface parallel to the hull's costs nothing)

@@ -3,7 +3,10 @@
 // (kernels/cost_volume.cl), one launch per block of depth slices.
 //  - orientation (paper Eq. 4-5): e(p, D) = sum_v -Re(O_ref(p)* O_v(P_v(p, D)) exp(2i(phi_ref -
 //    phi_v))), O_v sampled bilinearly at the level's resolution; views where P_v(p, D) falls
-//    outside the image add nothing;
+//    outside the image add nothing. Bilinear sampling damps a band-pass field most half-way
+//    between pixels, which could pull the depths towards whole-pixel disparities; Catmull-Rom
+//    sampling instead (a prototype at stop 56) gave the g2 group of synth_straight_gantry 4.01
+//    mm against 4.02 (the data term alone 4.54 against 4.56 mm): no such pull to speak of;
 //  - photometric baseline: e(p, D) = -sum_v NCC_v(p, D), the zero-mean NCC of the colour windows
 //    (fronto-parallel in depth-label space), O(1) per pixel with box filters.
 // Slice k of a block is label v = label_base[p] + (slice_begin + k) * label_step.
