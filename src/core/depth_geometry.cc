@@ -171,13 +171,23 @@ FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
     for (int c = 0; c < width; ++c) {
       const double d = depth.At(r, c);
       if (!(d > 0)) continue;
+      const Eigen::Vector3d ray = BackProjectPixel(K, c, r, d).normalized();
       Eigen::Vector3d t_col, t_row;
-      if (!tangent(r, c, d, 0, 1, &t_col) || !tangent(r, c, d, 1, 0, &t_row)) continue;
-      Eigen::Vector3d n = t_col.cross(t_row);
+      const bool has_col = tangent(r, c, d, 0, 1, &t_col);
+      const bool has_row = tangent(r, c, d, 1, 0, &t_row);
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      if (has_col && has_row) {
+        n = t_col.cross(t_row);
+      } else if (has_col || has_row) {
+        // One tangent (a strand one pixel wide): the normal across it that faces the camera
+        // most, as a strand's does where the viewer sees it.
+        const Eigen::Vector3d along = (has_col ? t_col : t_row).normalized();
+        n = along.dot(ray) * along - ray;
+      }
       const double norm = n.norm();
-      if (!(norm > 0)) continue;
-      n /= norm;
-      if (n.dot(BackProjectPixel(K, c, r, d)) > 0) n = -n;
+      // No tangent, or degenerate ones: the line of sight reversed.
+      n = norm > 1e-9 ? Eigen::Vector3d(n / norm) : Eigen::Vector3d(-ray);
+      if (n.dot(ray) > 0) n = -n;
       for (int k = 0; k < 3; ++k) normals.At(r, c, k) = static_cast<float>(n(k));
     }
   }

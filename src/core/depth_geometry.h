@@ -89,10 +89,13 @@ struct StereoCamera {
 
 // Camera-frame unit normals (3 channels: x, y, z) of the surface of a z-depth map, from
 // central differences of the back-projected neighbours (one-sided where one neighbour is
-// missing or across a discontinuity), oriented towards the camera (n . X < 0). 0 where the
-// depth is invalid (<= 0) or where a direction has no usable neighbour. Two neighbours are
-// discontinuous when their depths differ by more than max_slope * depth / focal, i.e. the
-// surface would be steeper than atan(max_slope) from fronto-parallel (default ~84 degrees).
+// missing or across a discontinuity), oriented towards the camera (n . X < 0); 0 exactly where
+// the depth is invalid (<= 0), as in COLMAP's maps, whose fusion drops a depth without a normal.
+// Where one image direction has no usable neighbour (a strand one pixel wide), the normal is
+// the one across the other direction's tangent that faces the camera most; where neither has
+// (an isolated depth), the line of sight reversed. Two neighbours are discontinuous when their
+// depths differ by more than max_slope * depth / focal, i.e. the surface would be steeper than
+// atan(max_slope) from fronto-parallel (default ~84 degrees).
 FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
                                double max_slope = 10.0);
 

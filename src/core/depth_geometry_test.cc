@@ -4,6 +4,7 @@
 
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <utility>
 #include <vector>
 
@@ -135,10 +136,30 @@ TEST(DepthGeometry, NormalsOfATiltedPlane) {
 
 TEST(DepthGeometry, NormalsFaceTheCameraAndStopAtDiscontinuities) {
   const Eigen::Matrix3d K = TestK();
-  FloatMap depth(9, 1, 1, 0.0f);
-  // A single row has no vertical neighbour: no normal.
-  depth.At(0, 4) = 1.0f;
-  EXPECT_EQ(NormalMapFromDepthMap(depth, K).At(0, 4, 2), 0.0f);
+  // A strand one pixel wide, along a row tilted in depth, has no vertical neighbour: its normal
+  // is the one across the row's tangent that faces the camera most.
+  FloatMap depth(9, 3, 1, 0.0f);
+  for (int col = 0; col < 9; ++col) depth.At(1, col) = 1.0f + 0.01f * col;
+  const FloatMap strand = NormalMapFromDepthMap(depth, K);
+  for (int col = 0; col < 9; ++col) {
+    const Eigen::Vector3d m(strand.At(1, col, 0), strand.At(1, col, 1), strand.At(1, col, 2));
+    EXPECT_NEAR(m.norm(), 1.0, 1e-6) << col;
+    const Eigen::Vector3d ray = BackProjectPixel(K, col, 1, depth.At(1, col)).normalized();
+    EXPECT_LT(m.dot(ray), 0.0) << col;  // faces the camera
+    // Perpendicular to the strand's tangent (between its neighbours, or one-sided at its ends).
+    const int a = std::max(col - 1, 0), b = std::min(col + 1, 8);
+    const Eigen::Vector3d along = BackProjectPixel(K, b, 1, depth.At(1, b)) -
+                                  BackProjectPixel(K, a, 1, depth.At(1, a));
+    EXPECT_NEAR(m.dot(along.normalized()), 0.0, 1e-5) << col;
+    // Of the normals across it, the one nearest the reversed line of sight: in their plane.
+    EXPECT_NEAR(m.dot(along.cross(ray).normalized()), 0.0, 1e-5) << col;
+  }
+  // Only invalid depths have no normal (COLMAP's fusion drops a depth whose normal is 0).
+  for (int row : {0, 2}) {
+    for (int col = 0; col < 9; ++col) {
+      for (int k = 0; k < 3; ++k) EXPECT_EQ(strand.At(row, col, k), 0.0f);
+    }
+  }
 
   FloatMap step(12, 12, 1, 1.0f);
   for (int r = 0; r < 12; ++r) {
@@ -153,10 +174,13 @@ TEST(DepthGeometry, NormalsFaceTheCameraAndStopAtDiscontinuities) {
       EXPECT_NEAR((m - expected).norm(), 0.0, 1e-5) << r << " " << col;
     }
   }
-  // An isolated pixel surrounded by a far background gets no normal.
+  // An isolated pixel in front of a far background faces the camera along its line of sight.
   FloatMap spike(5, 5, 1, 3.0f);
   spike.At(2, 2) = 1.0f;
-  EXPECT_EQ(NormalMapFromDepthMap(spike, K).At(2, 2, 2), 0.0f);
+  const FloatMap spike_normals = NormalMapFromDepthMap(spike, K);
+  const Eigen::Vector3d m(spike_normals.At(2, 2, 0), spike_normals.At(2, 2, 1),
+                          spike_normals.At(2, 2, 2));
+  EXPECT_NEAR((m + BackProjectPixel(K, 2, 2, 1.0).normalized()).norm(), 0.0, 1e-6);
 }
 
 TEST(DepthGeometry, SampleDepthMapInterpolatesOneSurfaceOnly) {

@@ -48,7 +48,7 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
         ++num_taken[v];
         const Eigen::Vector3d world = view.BackProject(col, row, depth);
         Eigen::Vector3d normal = view.WorldNormalAt(row, col);
-        if (normal.squaredNorm() < 0.5) continue;  // no normal where the depth is isolated
+        if (normal.squaredNorm() < 0.5) continue;  // a map without a normal here
         std::vector<uint32_t> visible;
         for (size_t j = 0; j < views.size(); ++j) {
           if (static_cast<int>(j) == v) {

@@ -267,7 +267,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       view.rgb = ResizeNearest(workspace.ReadViewRgb(name), view.depth.Width(),
                                view.depth.Height());
       views.push_back(std::move(view));
-      image_idx_of_view.push_back(static_cast<uint32_t>(idx));
+      image_idx_of_view.push_back(static_cast<uint32_t>(workspace.ImageIdx(name)));
     }
     progress.Finish();
     // Mixed maps are worth a word: a view whose geometric pass did not run (or failed) brings
