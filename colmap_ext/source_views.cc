@@ -153,10 +153,11 @@ SourceViewSelection SelectAuto(const Workspace& ws, const Image& reference,
   std::vector<Candidate> candidates;
   int num_sharing = 0;
   for (const auto& [other_id, stats] : pairs) {
+    const Image& other = model.images.at(other_id);
+    if (!ws.HasImageFile(other.name)) continue;  // not in images/: no view
     ++num_sharing;
     const double angle75 = Percentile(stats.angles_rad, 75.0);
     if (angle75 < min_angle) continue;
-    const Image& other = model.images.at(other_id);
     Candidate c;
     c.image_id = other_id;
     c.name = other.name;
@@ -372,6 +373,13 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
     SourceViewSelection selection;
     std::ostringstream where;
     if (!origin_prefix.empty()) where << origin_prefix << ":" << problem.line_number << " ";
+    const std::string listed_by = origin_prefix.empty()
+                                      ? std::string()
+                                      : cfg_path + ":" + std::to_string(problem.line_number);
+    ws.RequireView(problem.reference, listed_by);
+    if (problem.kind == PatchMatchProblem::Kind::kExplicit) {
+      for (const std::string& source : problem.sources) ws.RequireView(source, listed_by);
+    }
     switch (problem.kind) {
       case PatchMatchProblem::Kind::kExplicit:
         selection.reference = problem.reference;

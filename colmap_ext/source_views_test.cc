@@ -157,6 +157,39 @@ TEST(SourceViews, TriangulationAngleTestsAndConfig) {
       << folder;
 }
 
+// A model image that images/ lacks (`colmap image_undistorter --image_list_path`) is no
+// source: automatic and __all__ lists leave it out, and a config that names it is refused with
+// its file and line.
+TEST(SourceViews, ImagesWithoutAFileAreNoSources) {
+  std::vector<unsigned> visibility(30, 0b111u);
+  const Reconstruction model = MakeRig({{0, 0, 0}, {0.1, 0, 0}, {-0.1, 0, 0}},
+                                       {"a.png", "gone.png", "c.png"}, visibility);
+  const std::string dir = MakeTestDir("sources_without_file");
+  WriteTestWorkspace(dir, model);
+  std::filesystem::remove(JoinPaths(dir, "images", "gone.png"));
+  const Workspace ws = Workspace::Read(dir);
+  SourceViewOptions options;
+  std::vector<SourceViewSelection> s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 2u);
+  EXPECT_EQ(s[0].reference, "a.png");
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"c.png"}));
+  EXPECT_EQ(s[1].sources, (std::vector<std::string>{"a.png"}));
+  const std::string cfg = JoinPaths(dir, "stereo", "patch-match.cfg");
+  WriteFileAtomically(cfg, [](std::ostream& out) { out << "a.png\n__all__\n"; });
+  s = SelectSourceViews(ws, options);
+  ASSERT_EQ(s.size(), 1u);
+  EXPECT_EQ(s[0].sources, (std::vector<std::string>{"c.png"}));
+  WriteFileAtomically(cfg, [](std::ostream& out) { out << "a.png\ngone.png, c.png\n"; });
+  std::string error = ErrorOf([&] { SelectSourceViews(ws, options); });
+  EXPECT_NE(error.find("Image `gone.png` (" + cfg + ":2) is in the model of " + dir +
+                       " but not in its images folder"),
+            std::string::npos)
+      << error;
+  WriteFileAtomically(cfg, [](std::ostream& out) { out << "gone.png\n__auto__, 2\n"; });
+  error = ErrorOf([&] { SelectSourceViews(ws, options); });
+  EXPECT_NE(error.find("Image `gone.png` (" + cfg + ":2)"), std::string::npos) << error;
+}
+
 // A list longer than max_num_source_views, explicit or __all__, keeps the views sharing the
 // most points (ties: the listed order), and the estimate and the geometric pass use just those.
 // Empty tokens are skipped, as COLMAP's CSVToVector skips them.

@@ -62,11 +62,29 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
   THROW_IF(!ExistsDir(images), "Missing images folder: " << images);
   for (uint32_t id : ws.model_.image_order) {
     const Image& image = ws.model_.images.at(id);
-    const std::string image_path = JoinPaths(images, image.name);
-    THROW_IF(!ExistsFile(image_path), "Image " << image.name << " is listed in the model "
-                                               << sparse << " but missing: " << image_path);
-    ws.image_id_by_name_.emplace(image.name, id);  // unique: ReadReconstruction checks it
-    ws.image_names_.push_back(image.name);
+    // Unique: ReadReconstruction checks it.
+    ws.image_id_by_name_.emplace(image.name, id);
+    ws.image_idx_by_name_.emplace(image.name, static_cast<int>(ws.image_idx_by_name_.size()));
+    (ExistsFile(JoinPaths(images, image.name)) ? ws.image_names_ : ws.images_without_file_)
+        .push_back(image.name);
+  }
+  // `colmap image_undistorter --image_list_path` writes the whole model but only the listed
+  // images, and COLMAP's stereo and fusion then read only those: the others are no views here.
+  THROW_IF(ws.image_names_.empty(),
+           "None of the " << ws.images_without_file_.size() << " images of the model " << sparse
+                          << " is in " << images << " (the first: "
+                          << JoinPaths(images, ws.images_without_file_.front()) << ")");
+  if (!ws.images_without_file_.empty()) {
+    std::ostringstream names;
+    for (size_t i = 0; i < ws.images_without_file_.size() && i < 5; ++i) {
+      names << (i ? ", " : "") << ws.images_without_file_[i];
+    }
+    if (ws.images_without_file_.size() > 5) names << ", ...";
+    LOG(WARNING) << images << " holds " << ws.image_names_.size() << " of the "
+                 << ws.model_.images.size() << " images of the model " << sparse
+                 << "; the others (" << names.str()
+                 << ") are neither estimated nor source views, as after `colmap "
+                    "image_undistorter --image_list_path`";
   }
   if (!mask_path.empty()) {
     THROW_IF(!ExistsDir(mask_path), "Missing mask folder (the mask_path given): " << mask_path);
@@ -157,11 +175,25 @@ std::vector<std::string> Workspace::ImagesWithoutMask() const {
 }
 
 int Workspace::ImageIdx(const std::string& name, const std::string& given_by) const {
-  const auto it = std::find(image_names_.begin(), image_names_.end(), name);
-  THROW_IF(it == image_names_.end(),
+  const auto it = image_idx_by_name_.find(name);
+  THROW_IF(it == image_idx_by_name_.end(),
            "Image with name `" << name << "`" << (given_by.empty() ? "" : " (" + given_by + ")")
                                << " does not exist in workspace " << path_);
-  return static_cast<int>(it - image_names_.begin());
+  return it->second;
+}
+
+bool Workspace::HasImageFile(const std::string& name) const {
+  return std::find(images_without_file_.begin(), images_without_file_.end(), name) ==
+             images_without_file_.end() &&
+         image_idx_by_name_.count(name) > 0;
+}
+
+void Workspace::RequireView(const std::string& name, const std::string& given_by) const {
+  ImageIdx(name, given_by);
+  THROW_IF(!HasImageFile(name),
+           "Image `" << name << "`" << (given_by.empty() ? "" : " (" + given_by + ")")
+                     << " is in the model of " << path_
+                     << " but not in its images folder: " << ImagePath(name));
 }
 
 std::vector<std::string> Workspace::SelectImages(
@@ -169,6 +201,7 @@ std::vector<std::string> Workspace::SelectImages(
   if (requested.empty()) return image_names_;
   std::vector<int> seen;
   for (const std::string& name : requested) {
+    RequireView(name, "--image_names");
     const int idx = ImageIdx(name, "--image_names");
     THROW_IF(std::find(seen.begin(), seen.end(), idx) != seen.end(),
              "Image `" << name << "` is given twice (--image_names)");

@@ -25,22 +25,29 @@ class Workspace {
   // the photos they were undistorted from (undistort_masks' input, at the photos' sizes, which
   // are not checked against the images').
   enum class MasksOf { kImages, kPhotos };
-  // Reads the model of `path`/sparse and checks that every image of the model exists under
-  // images/. `mask_path` empty: `path`/masks if that folder exists, else no masks.
-  // Throws hairmvs::Error naming the file and the problem.
+  // Reads the model of `path`/sparse; its images found under images/ are the workspace's
+  // views (those missing are warned about, as `colmap image_undistorter --image_list_path`
+  // leaves them; none found is an error). `mask_path` empty: `path`/masks if that folder
+  // exists, else no masks. Throws hairmvs::Error naming the file and the problem.
   static Workspace Read(const std::string& path, const std::string& mask_path = "",
                         MasksOf masks_of = MasksOf::kImages);
 
   const std::string& Path() const { return path_; }
   const Reconstruction& Model() const { return model_; }
-  // Image names in COLMAP's image_idx order (the order of the records in sparse/images.*).
+  // The views: the names of the model's images that images/ holds, in COLMAP's image_idx order
+  // (the order of the records in sparse/images.*).
   const std::vector<std::string>& ImageNames() const { return image_names_; }
-  // Throws for an unknown name, saying where it was given (`given_by`, e.g. an option) if not
-  // empty.
+  // COLMAP's image_idx of a model image (its record's place in sparse/images.*, counting the
+  // images without a file too: what fused.ply.vis refers to). Throws for a name the model lacks,
+  // saying where it was given (`given_by`, e.g. an option) if not empty.
   int ImageIdx(const std::string& name, const std::string& given_by = "") const;
-  // The views a command works on: `requested` (--image_names) as given, or every image when it
-  // is empty. Throws for an unknown name, and for a name given twice (its maps would be
-  // computed twice, and it would count as two views).
+  // Whether `name` is one of ImageNames(): in the model and in images/.
+  bool HasImageFile(const std::string& name) const;
+  // Throws as ImageIdx does, and for a model image that images/ lacks, naming its path.
+  void RequireView(const std::string& name, const std::string& given_by = "") const;
+  // The views a command works on: `requested` (--image_names) as given, or every view when it
+  // is empty. Throws for a name that is no view (RequireView), and for a name given twice (its
+  // maps would be computed twice, and it would count as two views).
   std::vector<std::string> SelectImages(const std::vector<std::string>& requested) const;
   const Image& ImageByName(const std::string& name) const;
   // Throws (telling the user to run colmap image_undistorter) unless PINHOLE/SIMPLE_PINHOLE.
@@ -92,6 +99,8 @@ class Workspace {
   std::string mask_path_;
   Reconstruction model_;
   std::vector<std::string> image_names_;
+  std::vector<std::string> images_without_file_;  // model images that images/ lacks
+  std::unordered_map<std::string, int> image_idx_by_name_;  // every model image's
   // The model's image_id of each name (ImageByName without a search through the model).
   std::unordered_map<std::string, uint32_t> image_id_by_name_;
 };

@@ -125,13 +125,36 @@ TEST(Workspace, BadWorkspaces) {
   WriteReconstruction(empty, JoinPaths(dir, "empty", "sparse"), ModelFormat::kText);
   EXPECT_NE(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "empty")); }).find("no images"),
             std::string::npos);
-  // Image listed but missing.
+  // An image of the model that images/ lacks (`colmap image_undistorter --image_list_path`
+  // writes the whole model, only the listed images): said, and no view; its image_idx is
+  // still its record's place in the model (fused.ply.vis counts it).
   const std::string missing = JoinPaths(dir, "missing");
   WriteTestWorkspace(missing, MakePlaneModel());
   std::filesystem::remove(JoinPaths(missing, "images", "b.png"));
-  const std::string error = ErrorOf([&] { Workspace::Read(missing); });
-  EXPECT_NE(error.find("b.png"), std::string::npos) << error;
-  EXPECT_NE(error.find("missing"), std::string::npos) << error;
+  ::testing::internal::CaptureStderr();
+  const Workspace partial = Workspace::Read(missing);
+  const std::string warning = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(warning.find("holds 2 of the 3 images of the model"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("(b.png)"), std::string::npos) << warning;
+  EXPECT_EQ(partial.ImageNames(), (std::vector<std::string>{"a.png", "c.png"}));
+  EXPECT_EQ(partial.SelectImages({}), partial.ImageNames());
+  EXPECT_EQ(partial.ImageIdx("b.png"), 1);
+  EXPECT_EQ(partial.ImageIdx("c.png"), 2);
+  EXPECT_FALSE(partial.HasImageFile("b.png"));
+  EXPECT_TRUE(partial.HasImageFile("c.png"));
+  EXPECT_FALSE(partial.HasImageFile("d.png"));
+  const std::string error = ErrorOf([&] { partial.SelectImages({"b.png"}); });
+  EXPECT_NE(error.find("Image `b.png` (--image_names) is in the model of " + missing +
+                       " but not in its images folder: " + JoinPaths(missing, "images", "b.png")),
+            std::string::npos)
+      << error;
+  // None of them there: an error naming the first.
+  for (const char* name : {"a.png", "c.png"}) {
+    std::filesystem::remove(JoinPaths(missing, "images", name));
+  }
+  const std::string none = ErrorOf([&] { Workspace::Read(missing); });
+  EXPECT_NE(none.find("None of the 3 images of the model"), std::string::npos) << none;
+  EXPECT_NE(none.find(JoinPaths(missing, "images", "a.png")), std::string::npos) << none;
   // A distorted camera: reading works, CameraOf tells the user to undistort.
   const std::string distorted = JoinPaths(dir, "distorted");
   Reconstruction model = MakePlaneModel();
