@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iomanip>
 #include <optional>
 #include <random>
@@ -299,6 +300,12 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
   DepthEvaluationResult result;
   DepthSamples pooled;
   std::mt19937 rng(options.seed);
+  // The error pictures are made in a hidden folder and moved into place with the summary, once
+  // every view is evaluated: a run that stops on a bad file leaves the pictures and the summary
+  // of the run before, which agree.
+  std::optional<ScratchDir> pictures;
+  std::vector<std::string> picture_names;
+  if (options.write_error_images) pictures.emplace(output_path, ".evaluate_depth.pictures");
   Progress progress("evaluate_depth", static_cast<int>(names.size()));
   for (size_t v = 0; v < names.size(); ++v) {
     const std::string& name = names[v];
@@ -431,8 +438,8 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
       colours.copyTo(error_image, has_depth);
       for (const auto& [suffix, image] : {std::pair(".error.png", &error_image),
                                           std::pair(".signed_error.png", &signed_image)}) {
-        const std::string png = JoinPaths(output_path, name + suffix);
-        WriteImage(png, *image);
+        picture_names.push_back(name + suffix);
+        WriteImage(JoinPaths(pictures->Path(), picture_names.back()), *image);
       }
       laps.Lap("error pictures");
     }
@@ -453,6 +460,14 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
   json["views"] = nlohmann::json::array();
   for (const DepthMetrics& m : result.views) json["views"].push_back(ToJson(m));
   result.json_path = JoinPaths(output_path, "depth_evaluation.json");
+  for (const std::string& picture : picture_names) {
+    const std::string from = JoinPaths(pictures->Path(), picture);
+    const std::string to = JoinPaths(output_path, picture);
+    CreateDirs(ParentPath(to));  // an image name with folders
+    std::error_code ec;
+    std::filesystem::rename(from, to, ec);
+    THROW_IF(ec, "Cannot rename " << from << " to " << to << ": " << ec.message());
+  }
   WriteJsonSummary(result.json_path, json);
   laps.Lap("summary");
   return result;

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 #include <iomanip>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -56,21 +57,21 @@ void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy)
   }
 }
 
-// The imported maps are the truth of the true cameras: the model in sparse_path takes the
-// true poses of the views `names` (gt/cameras.npz), from which a mapper's differ
-// (synth_handheld: 0.24-0.43 degrees, 0.5-14 mm), so that the maps back-project onto the true
-// strands in fusion and compare with the truth at their own pixels in evaluate_depth. Left as
-// copied where the poses are the true ones already (the gantry sets).
-void UseTrueCameraPoses(const std::string& ground_truth_path,
-                        const std::vector<std::string>& names, const std::string& sparse_path) {
+// The imported maps are the truth of the true cameras: the workspace's model with the true
+// poses of the views `names` (gt/cameras.npz), from which a mapper's differ (synth_handheld:
+// 0.24-0.43 degrees, 0.5-14 mm), so that the maps back-project onto the true strands in fusion
+// and compare with the truth at their own pixels in evaluate_depth. Empty where the poses are
+// the true ones already (the gantry sets): the model is copied as it is.
+std::optional<Reconstruction> ModelWithTrueCameraPoses(const std::string& ground_truth_path,
+                                                       const std::vector<std::string>& names,
+                                                       Reconstruction model) {
   const std::string cameras_path = GroundTruthCamerasPath(ground_truth_path);
   if (!ExistsFile(cameras_path)) {
     LOG(WARNING) << "No " << cameras_path
                  << ": the workspace's poses are kept, and must be the true ones";
-    return;
+    return std::nullopt;
   }
   const GroundTruthCameras cameras = ReadGroundTruthCameras(ground_truth_path);
-  Reconstruction model = ReadReconstruction(sparse_path);
   double max_angle_rad = 0, max_shift_m = 0;
   for (auto& [id, image] : model.images) {
     if (std::find(names.begin(), names.end(), image.name) == names.end()) continue;
@@ -89,12 +90,11 @@ void UseTrueCameraPoses(const std::string& ground_truth_path,
                    << cameras_path << "'s; the true depths are written as they are";
     }
   }
-  if (max_angle_rad < 1e-9 && max_shift_m < 1e-9) return;
-  const bool binary = ExistsFile(JoinPaths(sparse_path, "images.bin"));
-  WriteReconstruction(model, sparse_path, binary ? ModelFormat::kBinary : ModelFormat::kText);
+  if (max_angle_rad < 1e-9 && max_shift_m < 1e-9) return std::nullopt;
   LOG(INFO) << "The true poses replace the workspace's for the imported views (which were off "
             << "by up to " << std::setprecision(3) << max_angle_rad * 180 / M_PI << " degrees and "
             << max_shift_m * 1e3 << " mm)";
+  return model;
 }
 
 }  // namespace
@@ -142,6 +142,24 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
            "--output_path " << output_path << " contains the workspace " << workspace_path);
   const Workspace ws = Workspace::Read(workspace_path);
   const std::vector<std::string> names = ws.SelectImages(options.image_names);
+  // Every view's truth, read and checked against its camera. All of them before anything is
+  // written, so that a truth file cut short or of another data set leaves the output as it was:
+  // not a workspace half made, nor an old one whose maps then mix two runs' settings.
+  auto read_truth = [&](const std::string& name) {
+    GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
+    const Camera& camera = ws.CameraOf(name);
+    THROW_IF(static_cast<int>(camera.width) != view.depth.Width() ||
+                 static_cast<int>(camera.height) != view.depth.Height(),
+             "Image " << name << ": the workspace camera is " << camera.width << " x "
+                      << camera.height << " but the ground truth "
+                      << GroundTruthViewPath(ground_truth_path, name) << " is "
+                      << view.depth.Width() << " x " << view.depth.Height());
+    return view;
+  };
+  for (const std::string& name : names) read_truth(name);
+  const std::optional<Reconstruction> true_pose_model =
+      ModelWithTrueCameraPoses(ground_truth_path, names, ws.Model());
+  laps.Lap("check truth");
 
   // The frame of the new workspace: model, images, masks, configuration.
   CreateDirs(output_path);
@@ -160,7 +178,12 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
     const std::string from = JoinPaths(workspace_path, "stereo", cfg);
     if (ExistsFile(from)) CopyFileAtomically(from, JoinPaths(output_path, "stereo", cfg));
   }
-  UseTrueCameraPoses(ground_truth_path, names, JoinPaths(output_path, "sparse"));
+  if (true_pose_model) {
+    const std::string sparse_out = JoinPaths(output_path, "sparse");
+    const bool binary = ExistsFile(JoinPaths(sparse_out, "images.bin"));
+    WriteReconstruction(*true_pose_model, sparse_out,
+                        binary ? ModelFormat::kBinary : ModelFormat::kText);
+  }
   const Workspace out_ws = Workspace::Read(output_path);
   laps.Lap("workspace frame");
 
@@ -174,15 +197,9 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   Progress progress("import_ground_truth", static_cast<int>(names.size()));
   for (const std::string& name : names) {
     progress.Start(result.num_views, name);
-    const GroundTruthView view = ReadGroundTruthView(ground_truth_path, name);
-    laps.Lap("read truth");
+    const GroundTruthView view = read_truth(name);
     const Camera& camera = ws.CameraOf(name);
-    THROW_IF(static_cast<int>(camera.width) != view.depth.Width() ||
-                 static_cast<int>(camera.height) != view.depth.Height(),
-             "Image " << name << ": the workspace camera is " << camera.width << " x "
-                      << camera.height << " but the ground truth "
-                      << GroundTruthViewPath(ground_truth_path, name) << " is "
-                      << view.depth.Width() << " x " << view.depth.Height());
+    laps.Lap("read truth");
     FloatMap depth = view.depth;
     const auto keeps = [&](size_t p) {
       const uint8_t label = view.label[p];

@@ -199,14 +199,15 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
   Timer total_timer;
   StageTimings local_timings;
   if (timings == nullptr) timings = &local_timings;
-  // fused.ply and meshed-hair.ply go there, after minutes of work.
-  RequireWritableDir(workspace_path, "workspace");
 
   std::vector<FusionView> views;
   std::vector<uint32_t> image_idx_of_view;
   {
     ScopedStageTimer timer(timings, "read depth maps");
     const Workspace workspace = Workspace::Read(workspace_path);
+    // fused.ply and meshed-hair.ply go there, after minutes of work. (After the workspace is
+    // read: a mistyped path is refused as no workspace, not made.)
+    RequireWritableDir(workspace_path, "workspace");
     const std::vector<std::string>& names = workspace.ImageNames();
     // As colmap stereo_fusion: stereo/fusion.cfg, where it exists, says which views are fused
     // (their index in .vis stays the model's).

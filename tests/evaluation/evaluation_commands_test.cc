@@ -778,6 +778,68 @@ TEST(EvaluationCommands, ImportRefusesToWriteIntoItsInputs) {
                Error);
 }
 
+// The bytes of a file, to tell whether a failed run left it as it was.
+std::string FileBytes(const std::string& path) { return ReadTextFile(path); }
+
+// `path` cut to half its size.
+void TruncateToHalf(const std::string& path) {
+  std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
+}
+
+// A truth file cut short stops import_ground_truth before anything is written: no new
+// workspace half made, and an existing one keeps every map of its own run (not some maps of
+// the failed run's settings beside others of the old's).
+TEST(EvaluationCommands, ImportStopsOnABadTruthBeforeWriting) {
+  const Scene scene = MakeScene("bad_truth");
+  const std::string gt_bad = JoinPaths(scene.dir, "gt_bad");
+  std::filesystem::copy(scene.gt, gt_bad);
+  TruncateToHalf(GroundTruthViewPath(gt_bad, "v1.png"));
+  const std::string fresh = JoinPaths(scene.dir, "fresh");
+  std::string error = testing_util::ErrorOf(
+      [&] { ImportGroundTruth(gt_bad, scene.workspace, fresh, ImportGroundTruthOptions()); });
+  EXPECT_NE(error.find(GroundTruthViewPath(gt_bad, "v1.png")), std::string::npos) << error;
+  EXPECT_FALSE(std::filesystem::exists(fresh));
+
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  const Workspace ws = Workspace::Read(out);
+  const std::string v0_map = FileBytes(ws.DepthMapPath("v0.png"));
+  ImportGroundTruthOptions noisy;
+  noisy.noise_m = 0.01;
+  error = testing_util::ErrorOf([&] { ImportGroundTruth(gt_bad, scene.workspace, out, noisy); });
+  EXPECT_NE(error.find(GroundTruthViewPath(gt_bad, "v1.png")), std::string::npos) << error;
+  EXPECT_EQ(FileBytes(ws.DepthMapPath("v0.png")), v0_map);
+}
+
+// A depth map cut short stops evaluate_depth with the error pictures and the summary of the
+// run before, which agree: none of the views evaluated before it has a new picture.
+TEST(EvaluationCommands, EvaluationStoppedByABadMapLeavesTheOldPictures) {
+  const Scene scene = MakeScene("bad_map");
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  const DepthEvaluationResult first = EvaluateDepthMaps(out, scene.gt, FastDepthOptions());
+  const std::string folder = ParentPath(first.json_path);
+  const std::string picture = JoinPaths(folder, "v0.png.signed_error.png");
+  const std::string old_picture = FileBytes(picture), old_json = FileBytes(first.json_path);
+  // v0's depths 1 cm behind (its pictures would change), v1's map cut short.
+  const Workspace ws = Workspace::Read(out);
+  FloatMap v0 = ReadMat(ws.DepthMapPath("v0.png"));
+  for (float& d : v0.Data()) {
+    if (d > 0) d += 0.01f;
+  }
+  WriteMat(ws.DepthMapPath("v0.png"), v0);
+  TruncateToHalf(ws.DepthMapPath("v1.png"));
+  const std::string error =
+      testing_util::ErrorOf([&] { EvaluateDepthMaps(out, scene.gt, FastDepthOptions()); });
+  EXPECT_NE(error.find(ws.DepthMapPath("v1.png")), std::string::npos) << error;
+  EXPECT_EQ(FileBytes(picture), old_picture);
+  EXPECT_EQ(FileBytes(first.json_path), old_json);
+  // No hidden folder of the stopped run is left.
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
+  }
+}
+
 TriangleMesh HairPlaneMesh(double offset_z) {
   TriangleMesh mesh;
   const float z = static_cast<float>(kPlaneZ + offset_z);

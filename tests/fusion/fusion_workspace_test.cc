@@ -252,6 +252,12 @@ TEST(FusionWorkspace, NoDepthMapsIsAnErrorNamingTheFolder) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("stereo"), std::string::npos) << e.what();
   }
+  // A mistyped workspace path is refused as no workspace, and not made.
+  const std::string typo = JoinPaths(dir, "typo", "dense");
+  const std::string error =
+      testing_util::ErrorOf([&] { RunTemplateFusion(typo, TemplateFusionOptions(), nullptr); });
+  EXPECT_NE(error.find("Missing workspace folder: " + typo), std::string::npos) << error;
+  EXPECT_FALSE(std::filesystem::exists(JoinPaths(dir, "typo")));
   std::filesystem::remove_all(dir);
 }
 
