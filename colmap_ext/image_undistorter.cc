@@ -179,6 +179,20 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   // where its entries will live, so that they are renamed there, not across file systems.
   fs::path target = fs::weakly_canonical(fs::absolute(workspace_path));
   if (!target.has_filename()) target = target.parent_path();  // "dense/"
+  RequireExecutable(colmap_executable);  // before a folder is made for its output
+  // The workspace's parent folders that this run makes, removed again (if still empty) when it
+  // fails: a failed run leaves nothing behind.
+  struct MadeFolders {
+    std::vector<fs::path> paths;  // outermost first
+    bool keep = false;
+    ~MadeFolders() {
+      std::error_code ec;
+      for (auto it = paths.rbegin(); !keep && it != paths.rend(); ++it) fs::remove(*it, ec);
+    }
+  } made;
+  for (fs::path p = target.parent_path(); !p.empty() && !fs::exists(p); p = p.parent_path()) {
+    made.paths.insert(made.paths.begin(), p);
+  }
   CreateDirs(target.parent_path().string());
   // Beside the workspace (the same file system, so that its entries are renamed, not copied),
   // hidden, and removed if anything fails or colmap is stopped.
@@ -202,6 +216,7 @@ void RunImageUndistorter(const std::string& colmap_executable, const std::string
   }
   if (before_publishing) before_publishing(staging.Path());
   PublishWorkspace(staging.Path(), workspace_path);
+  made.keep = true;
 }
 
 MaskUndistortionResult UndistortMasks(const std::string& colmap_executable,

@@ -417,6 +417,13 @@ TEST(ColmapInterop, WorkspaceFromPhotosAppearsOnlyWhenWhole) {
             }).find("Cannot run no_such_colmap_here: not found in PATH"),
             std::string::npos);
   EXPECT_EQ(FolderEntries(out), nothing);
+  // Nor are the workspace's parent folders made, when colmap cannot run or fails.
+  const std::string deeper = JoinPaths(out, "new", "deeper", "dense");
+  EXPECT_THROW(RunImageUndistorter("/nonexistent/colmap", photos, sparse, deeper), Error);
+  EXPECT_THROW(RunImageUndistorter(WriteFailingColmap(dir, "exits_too", "exit 3"), photos, sparse,
+                                   deeper),
+               Error);
+  EXPECT_EQ(FolderEntries(out), nothing);
 
   error = ErrorOf([&] {
     RunImageUndistorter(WriteFailingColmap(dir, "interrupted", "kill -INT $PPID $$"), photos,
