@@ -523,8 +523,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   // A masks folder with missing masks is reported by Workspace::Read; no folder at all is the
   // state of a workspace fresh from colmap image_undistorter, which matches the whole scene.
   if (workspace.MaskFolder().empty()) {
-    LOG(WARNING) << JoinPaths(workspace_path, "masks")
-                 << " does not exist: every pixel is matched, the background too, and each "
+    const std::string masks = JoinPaths(workspace_path, "masks");
+    LOG(WARNING) << masks << (Exists(masks) ? " is no folder" : " does not exist")
+                 << ": every pixel is matched, the background too, and each "
                     "depth range comes from all of the view's sparse points. With hair masks "
                     "(masks/<image name>.png, 255 = hair) the depth maps cover the hair only, "
                     "within the masks' visual hull";
