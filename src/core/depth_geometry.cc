@@ -75,7 +75,30 @@ bool ContinuesSurface(double a, double b, double depth, double focal, double max
   return std::abs(a - b) <= max_slope * depth / focal;
 }
 
+// Whether the depth d at (r, c) continues its surface to its neighbour one step (dr, dc) ahead
+// and one step behind.
+void SurfaceNeighbours(const FloatMap& depth, int r, int c, double d, int dr, int dc,
+                       double focal, double max_slope, bool* ahead, bool* behind) {
+  const auto continues = [&](int nr, int nc) {
+    if (nr < 0 || nr >= depth.Height() || nc < 0 || nc >= depth.Width()) return false;
+    const double n = depth.At(nr, nc);
+    return n > 0 && ContinuesSurface(n, d, d, focal, max_slope);
+  };
+  *ahead = continues(r + dr, c + dc);
+  *behind = continues(r - dr, c - dc);
+}
+
 }  // namespace
+
+bool HasSurfaceNeighboursBothWays(const FloatMap& depth, int row, int col, double focal,
+                                  double max_slope) {
+  const double d = depth.At(row, col);
+  if (!(d > 0)) return false;
+  bool right, left, below, above;
+  SurfaceNeighbours(depth, row, col, d, 0, 1, focal, max_slope, &right, &left);
+  SurfaceNeighbours(depth, row, col, d, 1, 0, focal, max_slope, &below, &above);
+  return (right || left) && (below || above);
+}
 
 double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
                       double max_slope) {
@@ -147,22 +170,18 @@ FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
   const int height = depth.Height();
   FloatMap normals(width, height, 3, 0.0f);
   const double focal = 0.5 * (K(0, 0) + K(1, 1));
-  auto depth_at = [&](int r, int c) -> double {
-    if (r < 0 || r >= height || c < 0 || c >= width) return 0.0;
-    return depth.At(r, c);
-  };
   // Tangent along one image direction (dr, dc) at (r, c): central difference when both
   // neighbours continue the surface, one-sided when only one does, none otherwise.
   auto tangent = [&](int r, int c, double d, int dr, int dc, Eigen::Vector3d* t) {
-    const double d_plus = depth_at(r + dr, c + dc);
-    const double d_minus = depth_at(r - dr, c - dc);
-    const bool plus_ok = d_plus > 0 && ContinuesSurface(d_plus, d, d, focal, max_slope);
-    const bool minus_ok = d_minus > 0 && ContinuesSurface(d_minus, d, d, focal, max_slope);
+    bool plus_ok, minus_ok;
+    SurfaceNeighbours(depth, r, c, d, dr, dc, focal, max_slope, &plus_ok, &minus_ok);
     if (!plus_ok && !minus_ok) return false;
-    const Eigen::Vector3d p_plus = plus_ok ? BackProjectPixel(K, c + dc, r + dr, d_plus)
-                                           : BackProjectPixel(K, c, r, d);
-    const Eigen::Vector3d p_minus = minus_ok ? BackProjectPixel(K, c - dc, r - dr, d_minus)
-                                             : BackProjectPixel(K, c, r, d);
+    const Eigen::Vector3d p_plus =
+        plus_ok ? BackProjectPixel(K, c + dc, r + dr, depth.At(r + dr, c + dc))
+                : BackProjectPixel(K, c, r, d);
+    const Eigen::Vector3d p_minus =
+        minus_ok ? BackProjectPixel(K, c - dc, r - dr, depth.At(r - dr, c - dc))
+                 : BackProjectPixel(K, c, r, d);
     *t = p_plus - p_minus;
     return true;
   };

@@ -98,5 +98,10 @@ struct StereoCamera {
 // atan(max_slope) from fronto-parallel (default ~84 degrees).
 FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
                                double max_slope = 10.0);
+// Whether the depth at (row, col) (> 0) continues its surface (NormalMapFromDepthMap's rule)
+// to a neighbour along its row and to one along its column: where the normal is the surface's
+// own, not a fallback across a strand or along the line of sight.
+bool HasSurfaceNeighboursBothWays(const FloatMap& depth, int row, int col, double focal,
+                                  double max_slope = 10.0);
 
 }  // namespace hairmvs

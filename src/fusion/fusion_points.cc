@@ -40,6 +40,7 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
   for (int v = 0; v < static_cast<int>(views.size()); ++v) {
     const FusionView& view = views[v];
     CHECK_EQ(view.normal.Channels(), 3) << view.name << ": normals are needed";
+    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));  // NormalMapFromDepthMap's
     FusionPoints& out = per_view[v];
     for (int row = 0; row < view.depth.Height(); row += stride) {
       for (int col = 0; col < view.depth.Width(); col += stride) {
@@ -47,6 +48,12 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
         if (!(depth > 0)) continue;
         ++num_taken[v];
         const Eigen::Vector3d world = view.BackProject(col, row, depth);
+        // A depth without neighbours on its surface both ways (a strand a pixel wide, a lone
+        // depth) has no normal of its own to place a surface by: left out. (Fused, as COLMAP's
+        // maps ask with their normals, they cost the merge from synth_handheld's true depths
+        // with 1 mm of noise 0.478 -> 0.489 mm of surface accuracy, 67.5 -> 67.3% of the hair
+        // within 2 mm.)
+        if (!HasSurfaceNeighboursBothWays(view.depth, row, col, focal)) continue;
         Eigen::Vector3d normal = view.WorldNormalAt(row, col);
         if (normal.squaredNorm() < 0.5) continue;  // a map without a normal here
         std::vector<uint32_t> visible;
