@@ -198,6 +198,11 @@ __kernel void photometric_warp(__global const float* ref_rgb, int width, int hei
   o[5 * plane] = valid;
 }
 
+// The least colour variance of an NCC window (summed over R, G, B, colours in [0, 1]) that has
+// an NCC (PhotometricCostCpu's kMinNccVariance): a standard deviation of about 0.006 per
+// channel, 1.5 levels of 8 bits.
+#define kMinNccVariance 1e-4f
+
 // Photometric baseline, step 2: adds -NCC of one view to the cost block, from the window means
 // of the warp planes (box-filtered photometric_warp output) and of the reference:
 // ref_stats: [0..2] mean R, G, B; [3] mean sum_c Ir_c^2. Windows with any invalid sample add 0.
@@ -222,8 +227,13 @@ __kernel void photometric_accumulate(__global const float* ref_stats,
     mean_rr -= mr * mr;
     mean_vv -= mv * mv;
   }
-  const float denom = sqrt(max(mean_rr, 0.0f) * max(mean_vv, 0.0f));
-  const float ncc = denom > 1e-6f ? cross / denom : 0.0f;
+  // A window without texture has no NCC: 0. Each variance on its own: in float, E[x^2] -
+  // E[x]^2 from the box filter's sums errs by up to about 1e-5 where the window is flat, and
+  // times a textured window's variance that passes any small bound on the product, making an
+  // NCC of rounding noise (up to 0.2 in the tests).
+  const float ncc = mean_rr > kMinNccVariance && mean_vv > kMinNccVariance
+                        ? cross / sqrt(mean_rr * mean_vv)
+                        : 0.0f;
   cost[(size_t)k * plane + p] -= ncc;
 }
 

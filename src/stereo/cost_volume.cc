@@ -329,8 +329,10 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
               }
             }
           }
-          const double denom = std::sqrt(rr * vv) / n;
-          out.At(row, col, k) -= static_cast<float>(denom > 1e-6 ? cross / n / denom : 0.0);
+          // No NCC in a window without variance (kernels/cost_volume.cl's kMinNccVariance).
+          constexpr double kMinNccVariance = 1e-4;
+          const bool textured = rr / n > kMinNccVariance && vv / n > kMinNccVariance;
+          out.At(row, col, k) -= static_cast<float>(textured ? cross / std::sqrt(rr * vv) : 0.0);
         }
       }
     }

@@ -141,6 +141,29 @@ TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
               2e-3f)
         << "radius " << radius << ", 11 slices";
   }
+  // Uniform-in-depth labels; a source with the labels' points nearer than 1.3 m behind it (as
+  // in the orientation test); and flat colour in the reference and a source, whose windows
+  // have no variance (their NCC counts 0).
+  const DepthLabels linear(0.6, 2.0, 32, false);
+  Scene odd = scene;
+  odd.sources.push_back({LookAtCamera({0.3, 0, 1.3}, {0.3, 0, 2.3}, 100, 96, 72).PyramidLevel(1),
+                         RandomMap(48, 36, 3, 5, 0.0f)});
+  for (int row = 8; row < 24; ++row) {
+    for (int col = 6; col < 30; ++col) {
+      for (int c = 0; c < 3; ++c) {
+        odd.ref.field.At(row, col, c) = 0.5f;
+        odd.sources[0].field.At(row, col, c) = 0.25f;
+      }
+    }
+  }
+  for (const DepthLabels& sampling : {labels, linear}) {
+    CostVolumeCL volume(context.get(), StereoCost::kPhotometric, odd.ref, odd.sources,
+                        OrientationTransfer::kNone, 3);
+    const FloatMap expected =
+        PhotometricCostCpu(odd.ref, odd.sources, odd.base, 0.75f, 0, 32, sampling, 3);
+    EXPECT_LT(MaxAbsDiff(volume.Compute(odd.base, 0.75f, 0, 32, sampling), expected), 2e-3f)
+        << (sampling.inverse ? "inverse depth" : "depth");
+  }
 }
 
 // Between pyramid levels: level 1 (13 x 9) up to level 0 (25 x 18), an output pixel half a
