@@ -458,6 +458,42 @@ TEST(MrfSolvers, TiesGoToTheLowestLabelAndIcmKeepsTheCurrentOne) {
   EXPECT_EQ(MrfReadLabels(context->Queue(), labels, device.size()), start);
 }
 
+// The checkerboard ICM kernel on its own equals PolishWithIcm, from winner-take-all labels, on
+// a size that leaves a partial work-group (23 x 17), with truncation, label offsets and a
+// fractional label step, and each lowers the energy.
+TEST(Icm, OpenCLMatchesCpuReference) {
+  for (const float truncation : {std::numeric_limits<float>::infinity(), 4.0f}) {
+    // Label differences up to 6.5 (12 labels 0.5 apart, offsets up to 0.5): squared, past the
+    // truncation.
+    MrfProblem problem = RandomProblem(23, 17, 12, 0.6f, 11);
+    problem.truncation = truncation;
+    problem.label_step = 0.5f;
+    problem.label_offset.resize(problem.NumPixels());
+    for (size_t p = 0; p < problem.NumPixels(); ++p) problem.label_offset[p] = 0.013f * (p % 41);
+    const std::vector<int> start = WinnerTakeAll(problem);
+    std::vector<int> cpu = start;
+    PolishWithIcm(problem, 30, &cpu);
+    OpenCLContext* context = Context().get();
+    auto buffer = [&](const std::vector<float>& values) {
+      return cl::Buffer(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                        sizeof(float) * values.size(), const_cast<float*>(values.data()));
+    };
+    const cl::Buffer cost = buffer(problem.data_cost), offset = buffer(problem.label_offset),
+                     weight_right = buffer(problem.weight_right),
+                     weight_down = buffer(problem.weight_down);
+    std::vector<int> device = start;
+    const cl::Buffer labels(context->Context(), CL_MEM_READ_WRITE | CL_MEM_COPY_HOST_PTR,
+                            sizeof(int) * device.size(), device.data());
+    RunIcmOpenCL(context, cost, offset, weight_right, weight_down, problem, 30, labels);
+    device = MrfReadLabels(context->Queue(), labels, device.size());
+    int differing = 0;
+    for (size_t p = 0; p < device.size(); ++p) differing += device[p] != cpu[p];
+    EXPECT_EQ(differing, 0) << "truncation " << truncation;
+    EXPECT_NE(cpu, start) << "truncation " << truncation;  // ICM had work to do
+    EXPECT_LT(MrfEnergy(problem, cpu), MrfEnergy(problem, start)) << "truncation " << truncation;
+  }
+}
+
 // The OpenCL belief propagation (with and without the ICM polish on the device) equals its
 // CPU reference.
 TEST(BeliefPropagation, OpenCLMatchesCpuReference) {

@@ -108,19 +108,27 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   // A mask of the pixels where the prior is added (about two thirds), with the base only.
   std::vector<uint8_t> active(n);
   for (uint8_t& a : active) a = unit(rng) < 0.67f;
-  for (bool with_base : {true, false}) {
+  // Labels uniform in inverse depth (the default) and in depth; with and without a base and a
+  // mask, each on its own.
+  const DepthLabels linear(0.5, 2.0, 64, /*inverse=*/false);
+  for (int sampling_and_inputs = 0; sampling_and_inputs < 8; ++sampling_and_inputs) {
+    const DepthLabels& sampling = sampling_and_inputs < 4 ? labels : linear;
+    const bool with_base = sampling_and_inputs % 2 == 0;
+    const bool with_mask = sampling_and_inputs % 4 < 2;
+    const std::string what = std::string(sampling.inverse ? "inverse depth" : "depth") +
+                             (with_base ? ", base" : "") + (with_mask ? ", mask" : "");
     const std::vector<float> label_base = with_base ? base : std::vector<float>();
-    const std::vector<uint8_t> pixels = with_base ? active : std::vector<uint8_t>();
+    const std::vector<uint8_t> pixels = with_mask ? active : std::vector<uint8_t>();
     // Without a base: labels 0 to 55.1. (With 12 labels 5 apart, label 35's depth, 0.857 m,
     // put grid column 37 exactly on a pixel border of the third view, u = 40, in exact
     // arithmetic: a single-precision kernel then reads one side or the other of the whole
     // column.)
     const float step = with_base ? 0.75f : 2.9f;
     std::vector<float> expected(n * num_labels, 0.25f), got = expected;
-    AddGeometricPriorCpu(prior, grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f,
+    AddGeometricPriorCpu(prior, grid, 2.0, sampling, label_base, step, num_labels, pixels, 0.5f,
                          &expected);
     GeometricPriorCL(context.get(), prior)
-        .Add(grid, 2.0, labels, label_base, step, num_labels, pixels, 0.5f, &got);
+        .Add(grid, 2.0, sampling, label_base, step, num_labels, pixels, 0.5f, &got);
     // Single precision moves a projection by about 1e-4 px: where that crosses a pixel border
     // of a source map, the two read neighbouring depths (a few entries in a million).
     size_t close = 0, partial = 0, untouched = 0, inactive = 0;
@@ -133,12 +141,12 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
         untouched += got[i] == 0.25f && expected[i] == 0.25f;
       }
     }
-    EXPECT_GE(close, got.size() - got.size() / 1000) << with_base;
-    EXPECT_GT(partial, got.size() / 5) << with_base;
+    EXPECT_GE(close, got.size() - got.size() / 1000) << what;
+    EXPECT_GT(partial, got.size() / 5) << what;
     // Nothing added outside the mask.
-    EXPECT_EQ(untouched, inactive) << with_base;
-    if (with_base) {
-      EXPECT_GT(inactive, got.size() / 5);
+    EXPECT_EQ(untouched, inactive) << what;
+    if (with_mask) {
+      EXPECT_GT(inactive, got.size() / 5) << what;
     }
   }
 }
