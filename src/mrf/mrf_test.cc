@@ -375,6 +375,58 @@ TEST(SemiGlobal, PathMinimumEqualsBruteForce) {
   }
 }
 
+// Independent of the kernels' CPU copies: on a chain, the four scanline paths of semi-global
+// matching are the chain's dynamic programme in both directions (O(L^2) here) and two paths of
+// one pixel (its data cost), so the device's labels are the argmin of their sum; rows and
+// columns, with label offsets and a truncation that binds.
+TEST(SemiGlobal, ChainIsBothDynamicProgrammesPlusTwiceTheDataCost) {
+  for (const auto& [width, height] : {std::pair<int, int>{15, 1}, std::pair<int, int>{1, 15}}) {
+    MrfProblem problem = RandomProblem(width, height, 7, 0.8f, 31 + width);
+    problem.truncation = 2.0f;
+    problem.label_step = 0.5f;
+    problem.label_offset.resize(problem.NumPixels());
+    for (size_t p = 0; p < problem.NumPixels(); ++p) problem.label_offset[p] = 0.3f * (p % 4);
+    const int n = static_cast<int>(problem.NumPixels()), num_labels = problem.num_labels;
+    // The weight of the edge between chain pixels p and p + 1.
+    auto weight = [&](int p) {
+      return static_cast<double>(width > 1 ? problem.weight_right[p] : problem.weight_down[p]);
+    };
+    auto pairwise = [&](int p, int a, int q, int b) {
+      const double d = problem.Value(p, a) - problem.Value(q, b);
+      return weight(std::min(p, q)) * std::min(d * d, static_cast<double>(problem.truncation));
+    };
+    std::vector<std::vector<double>> sum(n, std::vector<double>(num_labels, 0.0));
+    for (int direction : {1, -1}) {
+      std::vector<double> previous;
+      for (int i = 0; i < n; ++i) {
+        const int p = direction > 0 ? i : n - 1 - i;
+        std::vector<double> path(num_labels);
+        for (int b = 0; b < num_labels; ++b) {
+          path[b] = problem.Cost(b, p);
+          if (!previous.empty()) {
+            const int q = p - direction;
+            double best = std::numeric_limits<double>::infinity();
+            for (int a = 0; a < num_labels; ++a) {
+              best = std::min(best, previous[a] + pairwise(q, a, p, b));
+            }
+            path[b] += best - *std::min_element(previous.begin(), previous.end());
+          }
+          sum[p][b] += path[b];
+        }
+        previous = path;
+      }
+    }
+    std::vector<int> expected(n);
+    for (int p = 0; p < n; ++p) {
+      for (int b = 0; b < num_labels; ++b) sum[p][b] += 2.0 * problem.Cost(b, p);
+      expected[p] = static_cast<int>(std::min_element(sum[p].begin(), sum[p].end()) -
+                                     sum[p].begin());
+    }
+    EXPECT_EQ(SolveSemiGlobalOpenCL(problem, 4, 0, Context().get()), expected)
+        << width << " x " << height;
+  }
+}
+
 // Independent of the kernels' CPU copies: on a chain (a tree), min-sum belief propagation is
 // exact, so the device's labels reach the dynamic programme's minimum; rows and columns, with
 // label offsets and truncation.
