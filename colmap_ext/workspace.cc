@@ -47,9 +47,10 @@ bool PngSize(const std::string& path, int* width, int* height) {
 Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
                           MasksOf masks_of) {
   THROW_IF(path.empty(), "Empty workspace path (--workspace_path)");
-  THROW_IF(!ExistsDir(path), "Missing workspace folder: " << path);
+  RequireDir(path, "workspace folder");
   const std::string sparse = JoinPaths(path, "sparse");
   const std::string images = JoinPaths(path, "images");
+  THROW_IF(ExistsFile(sparse), "The sparse model folder " << sparse << " is a file, not a folder");
   THROW_IF(!ExistsDir(sparse),
            "Missing sparse model: " << sparse
                                     << " (a COLMAP dense workspace as `colmap image_undistorter "
@@ -59,7 +60,7 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
   ws.model_ = ReadReconstruction(sparse);
   THROW_IF(ws.model_.images.empty(),
            "Empty workspace: the sparse model in " << sparse << " has no images");
-  THROW_IF(!ExistsDir(images), "Missing images folder: " << images);
+  RequireDir(images, "images folder");
   for (uint32_t id : ws.model_.image_order) {
     const Image& image = ws.model_.images.at(id);
     // Unique: ReadReconstruction checks it.

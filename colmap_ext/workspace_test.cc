@@ -120,6 +120,16 @@ TEST(Workspace, BadWorkspaces) {
   EXPECT_NE(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "empty_dir")); })
                 .find("Missing sparse model"),
             std::string::npos);
+  // A file where a folder belongs is said to be one, not missing.
+  const std::string file = JoinPaths(dir, "a_file");
+  WriteFileAtomically(file, [](std::ostream& out) { out << "x"; });
+  EXPECT_EQ(ErrorOf([&] { Workspace::Read(file); }),
+            "The workspace folder " + file + " is a file, not a folder");
+  WriteFileAtomically(JoinPaths(dir, "sparse_file", "sparse"),
+                      [](std::ostream& out) { out << "x"; });
+  EXPECT_EQ(ErrorOf([&] { Workspace::Read(JoinPaths(dir, "sparse_file")); }),
+            "The sparse model folder " + JoinPaths(dir, "sparse_file", "sparse") +
+                " is a file, not a folder");
   // Empty workspace: a model without images.
   Reconstruction empty;
   WriteReconstruction(empty, JoinPaths(dir, "empty", "sparse"), ModelFormat::kText);
