@@ -198,10 +198,12 @@ __kernel void photometric_warp(__global const float* ref_rgb, int width, int hei
   o[5 * plane] = valid;
 }
 
-// The least colour variance of an NCC window (summed over R, G, B, colours in [0, 1]) that has
-// an NCC (PhotometricCostCpu's kMinNccVariance): a standard deviation of about 0.006 per
-// channel, 1.5 levels of 8 bits.
-#define kMinNccVariance 1e-4f
+// The least colour variance of an NCC window, as a fraction of its mean square colour (both
+// summed over R, G, B), that has an NCC (PhotometricCostCpu's kMinNccVarianceRatio): colours
+// that vary by about 1% of their level. Relative, since the float error of E[x^2] - E[x]^2 from
+// the box filter's running sums grows with the colours' level, and dark hair has texture of a
+// small variance too.
+#define kMinNccVarianceRatio 1e-4f
 
 // Photometric baseline, step 2: adds -NCC of one view to the cost block, from the window means
 // of the warp planes (box-filtered photometric_warp output) and of the reference:
@@ -218,7 +220,8 @@ __kernel void photometric_accumulate(__global const float* ref_stats,
   const size_t plane = (size_t)width * height;
   __global const float* w = warp_means + (size_t)6 * k * plane + p;
   if (w[5 * plane] < 0.999f) return;
-  float mean_rr = ref_stats[3 * plane + p], mean_vv = w[3 * plane];
+  const float square_r = ref_stats[3 * plane + p], square_v = w[3 * plane];
+  float mean_rr = square_r, mean_vv = square_v;
   float cross = w[4 * plane];
   for (int ch = 0; ch < 3; ++ch) {
     const float mr = ref_stats[ch * plane + p];
@@ -227,11 +230,11 @@ __kernel void photometric_accumulate(__global const float* ref_stats,
     mean_rr -= mr * mr;
     mean_vv -= mv * mv;
   }
-  // A window without texture has no NCC: 0. Each variance on its own: in float, E[x^2] -
-  // E[x]^2 from the box filter's sums errs by up to about 1e-5 where the window is flat, and
-  // times a textured window's variance that passes any small bound on the product, making an
-  // NCC of rounding noise (up to 0.2 in the tests).
-  const float ncc = mean_rr > kMinNccVariance && mean_vv > kMinNccVariance
+  // A window without texture has no NCC: 0. Each variance on its own: in float, what E[x^2] -
+  // E[x]^2 leaves of a flat window is rounding, which times a textured window's variance
+  // passes any small bound on the product and makes an NCC of noise (up to 0.2 in the tests).
+  const float ncc = mean_rr > kMinNccVarianceRatio * square_r &&
+                            mean_vv > kMinNccVarianceRatio * square_v
                         ? cross / sqrt(mean_rr * mean_vv)
                         : 0.0f;
   cost[(size_t)k * plane + p] -= ncc;

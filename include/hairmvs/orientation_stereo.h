@@ -31,7 +31,7 @@ struct OrientationFieldOptions;
 enum class StereoCost {
   kOrientation,  // paper Eq. 5: -Re(O'_ref* O_v), O'_ref carried as orientation_transfer says
   // Baseline: -(zero-mean NCC of colour windows), same aggregation and MRF; a window of either
-  // view without texture (colour variance, summed over R, G, B, at most 1e-4) counts 0.
+  // view without texture (colour variance at most 1e-4 of the mean square colour) counts 0.
   kPhotometric,
   // (1 - photometric_weight) x orientation + photometric_weight x photometric, each
   // aggregated as above: the two cues fail in different places (see photometric_weight).

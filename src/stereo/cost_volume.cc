@@ -329,9 +329,20 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
               }
             }
           }
-          // No NCC in a window without variance (kernels/cost_volume.cl's kMinNccVariance).
-          constexpr double kMinNccVariance = 1e-4;
-          const bool textured = rr / n > kMinNccVariance && vv / n > kMinNccVariance;
+          // No NCC in a window whose colours vary by less than about 1% of their level
+          // (kernels/cost_volume.cl's kMinNccVarianceRatio).
+          constexpr double kMinNccVarianceRatio = 1e-4;
+          double square_r = 0, square_v = 0;
+          for (int r = r0; r <= r1; ++r) {
+            for (int q = c0; q <= c1; ++q) {
+              for (int c = 0; c < 3; ++c) {
+                square_r += static_cast<double>(ref.field.At(r, q, c)) * ref.field.At(r, q, c);
+                square_v += static_cast<double>(warped.At(r, q, c)) * warped.At(r, q, c);
+              }
+            }
+          }
+          const bool textured =
+              rr > kMinNccVarianceRatio * square_r && vv > kMinNccVarianceRatio * square_v;
           out.At(row, col, k) -= static_cast<float>(textured ? cross / std::sqrt(rr * vv) : 0.0);
         }
       }
