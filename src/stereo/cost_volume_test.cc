@@ -164,6 +164,19 @@ TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
     EXPECT_LT(MaxAbsDiff(volume.Compute(odd.base, 0.75f, 0, 32, sampling), expected), 2e-3f)
         << (sampling.inverse ? "inverse depth" : "depth");
   }
+  // The NCC does not depend on the colours' level: every view 100 times darker (dark hair,
+  // whose texture has a small variance) gives the same costs.
+  Scene dark = scene;
+  for (CostViewInput* view : {&dark.ref, &dark.sources[0], &dark.sources[1]}) {
+    for (float& c : view->field.Data()) c *= 0.01f;
+  }
+  CostVolumeCL bright_volume(context.get(), StereoCost::kPhotometric, scene.ref, scene.sources,
+                             OrientationTransfer::kNone, 3);
+  CostVolumeCL dark_volume(context.get(), StereoCost::kPhotometric, dark.ref, dark.sources,
+                           OrientationTransfer::kNone, 3);
+  EXPECT_LT(MaxAbsDiff(dark_volume.Compute(dark.base, 0.75f, 5, 3, labels),
+                       bright_volume.Compute(scene.base, 0.75f, 5, 3, labels)),
+            2e-3f);
 }
 
 // Between pyramid levels: level 1 (13 x 9) up to level 0 (25 x 18), an output pixel half a
