@@ -130,8 +130,7 @@ bool MapDepthOnRay(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eig
   const Eigen::Vector3d x = K * (R * world + t);
   if (!(x.z() > 0)) return false;
   *z = x.z();
-  *map_depth =
-      SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), 0.5 * (K(0, 0) + K(1, 1)));
+  *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), MeanFocalPx(K));
   return *map_depth > 0;
 }
 
@@ -169,7 +168,7 @@ FloatMap NormalMapFromDepthMap(const FloatMap& depth, const Eigen::Matrix3d& K,
   const int width = depth.Width();
   const int height = depth.Height();
   FloatMap normals(width, height, 3, 0.0f);
-  const double focal = 0.5 * (K(0, 0) + K(1, 1));
+  const double focal = MeanFocalPx(K);
   // Tangent along one image direction (dr, dc) at (r, c): central difference when both
   // neighbours continue the surface, one-sided when only one does, none otherwise.
   auto tangent = [&](int r, int c, double d, int dr, int dc, Eigen::Vector3d* t) {

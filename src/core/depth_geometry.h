@@ -27,6 +27,10 @@ bool ProjectToPixel(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Ei
                     int width, int height, const Eigen::Vector3d& world, int* col, int* row,
                     double* depth);
 
+// The focal length in px that the depth-continuity rule below (ContinuesSurface's slope)
+// takes: the mean of K's two.
+inline double MeanFocalPx(const Eigen::Matrix3d& K) { return 0.5 * (K(0, 0) + K(1, 1)); }
+
 // The z-depth of a map at image point (x, y) (pixel (col, row) centred at (col + 0.5,
 // row + 0.5)): bilinear between the four pixel centres around (x, y) where all four have a
 // depth and continue one surface (each pair of neighbours within max_slope * depth / focal,

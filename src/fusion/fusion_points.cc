@@ -40,7 +40,7 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
   for (int v = 0; v < static_cast<int>(views.size()); ++v) {
     const FusionView& view = views[v];
     CHECK_EQ(view.normal.Channels(), 3) << view.name << ": normals are needed";
-    const double focal = 0.5 * (view.K(0, 0) + view.K(1, 1));  // NormalMapFromDepthMap's
+    const double focal = MeanFocalPx(view.K);
     FusionPoints& out = per_view[v];
     for (int row = 0; row < view.depth.Height(); row += stride) {
       for (int col = 0; col < view.depth.Width(); col += stride) {
