@@ -449,7 +449,7 @@ ScratchDir::~ScratchDir() {
 StagingDir::StagingDir(const std::string& parent, const std::string& name)
     : parent_(parent), scratch_(parent, "." + name + ".staging") {}
 
-void StagingDir::Commit(const std::vector<std::string>& entries) {
+void StagingDir::Commit(const std::vector<std::string>& entries, bool replace) {
   THROW_IF(committed_, "StagingDir " << Path() << " was committed already");
   for (const std::string& entry : entries) {
     const std::string from = JoinPaths(Path(), entry);
@@ -457,13 +457,14 @@ void StagingDir::Commit(const std::vector<std::string>& entries) {
     std::error_code ec;
     THROW_IF(!fs::exists(fs::symlink_status(from, ec)),
              "Cannot move " << from << " into place: it was not written");
-    THROW_IF(fs::exists(fs::symlink_status(to, ec)),
+    THROW_IF(!replace && fs::exists(fs::symlink_status(to, ec)),
              "Cannot move " << from << " to " << to << ": " << to
                             << " exists already (written by another process meanwhile?)");
   }
   for (const std::string& entry : entries) {
     const std::string from = JoinPaths(Path(), entry);
     const std::string to = JoinPaths(parent_, entry);
+    if (replace) CreateDirs(ParentPath(to));
     std::error_code ec;
     fs::rename(from, to, ec);
     THROW_IF(ec, "Cannot rename " << from << " to " << to << ": " << ec.message());

@@ -103,10 +103,12 @@ class StagingDir {
 
   // The folder to write into.
   const std::string& Path() const { return scratch_.Path(); }
-  // Moves each of `entries` (names inside Path()) to `parent`/<entry>, in order. Throws
-  // hairmvs::Error naming the entry when one is missing here or exists already in `parent`
-  // (checked for all before any is moved), or when a rename fails.
-  void Commit(const std::vector<std::string>& entries);
+  // Moves each of `entries` (names inside Path(), which may hold folders) to `parent`/<entry>,
+  // in order. Throws hairmvs::Error naming the entry when one is missing here or, unless
+  // `replace`, exists already in `parent` (checked for all before any is moved), or when a
+  // rename fails. With `replace`, a file there is replaced (renamed over) and the entry's
+  // folders are made.
+  void Commit(const std::vector<std::string>& entries, bool replace = false);
 
  private:
   std::string parent_;

@@ -381,6 +381,15 @@ TEST(FileUtil, StagingDirMovesEntriesIntoPlaceOrRemovesThem) {
   EXPECT_EQ(ReadTextFile(JoinPaths(dir, "gt.txt")), "b");
   const std::string missing = testing_util::ErrorOf([&] { staging.Commit({"sparse"}); });
   EXPECT_NE(missing.find("sparse into place: it was not written"), std::string::npos) << missing;
+
+  // With replace: an existing file is replaced, and an entry's folders are made.
+  StagingDir replacing(dir, "pictures");
+  WriteFileAtomically(JoinPaths(replacing.Path(), "gt.txt"), [](std::ostream& out) { out << "r"; });
+  WriteFileAtomically(JoinPaths(replacing.Path(), "sub", "a.txt"),
+                      [](std::ostream& out) { out << "s"; });
+  replacing.Commit({"gt.txt", "sub/a.txt"}, /*replace=*/true);
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "gt.txt")), "r");
+  EXPECT_EQ(ReadTextFile(JoinPaths(dir, "sub", "a.txt")), "s");
 }
 
 TEST(FileUtil, RequireWritableDir) {

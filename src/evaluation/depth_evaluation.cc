@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <iomanip>
 #include <optional>
 #include <random>
@@ -303,9 +302,9 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
   // The error pictures are made in a hidden folder and moved into place with the summary, once
   // every view is evaluated: a run that stops on a bad file leaves the pictures and the summary
   // of the run before, which agree.
-  std::optional<ScratchDir> pictures;
+  std::optional<StagingDir> pictures;
   std::vector<std::string> picture_names;
-  if (options.write_error_images) pictures.emplace(output_path, ".evaluate_depth.pictures");
+  if (options.write_error_images) pictures.emplace(output_path, "evaluate_depth");
   Progress progress("evaluate_depth", static_cast<int>(names.size()));
   for (size_t v = 0; v < names.size(); ++v) {
     const std::string& name = names[v];
@@ -460,14 +459,7 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
   json["views"] = nlohmann::json::array();
   for (const DepthMetrics& m : result.views) json["views"].push_back(ToJson(m));
   result.json_path = JoinPaths(output_path, "depth_evaluation.json");
-  for (const std::string& picture : picture_names) {
-    const std::string from = JoinPaths(pictures->Path(), picture);
-    const std::string to = JoinPaths(output_path, picture);
-    CreateDirs(ParentPath(to));  // an image name with folders
-    std::error_code ec;
-    std::filesystem::rename(from, to, ec);
-    THROW_IF(ec, "Cannot rename " << from << " to " << to << ": " << ec.message());
-  }
+  if (pictures) pictures->Commit(picture_names, /*replace=*/true);
   WriteJsonSummary(result.json_path, json);
   laps.Lap("summary");
   return result;
