@@ -301,7 +301,8 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
       for (int row = 0; row < h; ++row) {
         for (int col = 0; col < w; ++col) {
           // Zero-mean NCC over the clipped window, colour channels centred separately.
-          double n = 0, mr[3] = {0, 0, 0}, mv[3] = {0, 0, 0};
+          // Sums of the colours and of their squares (the texture bound below is relative).
+          double n = 0, mr[3] = {0, 0, 0}, mv[3] = {0, 0, 0}, square_r = 0, square_v = 0;
           bool all_valid = true;
           const int r0 = std::max(row - ncc_radius, 0), r1 = std::min(row + ncc_radius, h - 1);
           const int c0 = std::max(col - ncc_radius, 0), c1 = std::min(col + ncc_radius, w - 1);
@@ -310,8 +311,11 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
               all_valid = all_valid && valid[r * w + q];
               n += 1;
               for (int c = 0; c < 3; ++c) {
-                mr[c] += ref.field.At(r, q, c);
-                mv[c] += warped.At(r, q, c);
+                const double a = ref.field.At(r, q, c), b = warped.At(r, q, c);
+                mr[c] += a;
+                mv[c] += b;
+                square_r += a * a;
+                square_v += b * b;
               }
             }
           }
@@ -332,15 +336,6 @@ FloatMap PhotometricCostCpu(const CostViewInput& ref, const std::vector<CostView
           // No NCC in a window whose colours vary by less than about 1% of their level
           // (kernels/cost_volume.cl's kMinNccVarianceRatio).
           constexpr double kMinNccVarianceRatio = 1e-4;
-          double square_r = 0, square_v = 0;
-          for (int r = r0; r <= r1; ++r) {
-            for (int q = c0; q <= c1; ++q) {
-              for (int c = 0; c < 3; ++c) {
-                square_r += static_cast<double>(ref.field.At(r, q, c)) * ref.field.At(r, q, c);
-                square_v += static_cast<double>(warped.At(r, q, c)) * warped.At(r, q, c);
-              }
-            }
-          }
           const bool textured =
               rr > kMinNccVarianceRatio * square_r && vv > kMinNccVarianceRatio * square_v;
           out.At(row, col, k) -= static_cast<float>(textured ? cross / std::sqrt(rr * vv) : 0.0);
