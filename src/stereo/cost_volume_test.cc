@@ -121,6 +121,54 @@ TEST(CostVolume, OrientationKernelMatchesTheCpuReference) {
             2e-4f);
 }
 
+// A source that sees the reference pixel's strand end-on (its camera centre lies on the strand's
+// line at one label's depth): the piece projects to a point there, has no direction, and the
+// source adds no term at that label, in the kernel as in the CPU reference. Every number here is
+// a short binary fraction, so the projections coincide exactly in float as in double.
+TEST(CostVolume, AStrandSeenEndOnAddsNoTerm) {
+  auto context = OpenCLContext::Create();
+  StereoCamera ref;  // at the origin looking along +z; row 17's pixel centres lie at y = cy
+  ref.K << 64, 0, 32, 0, 64, 17.5, 0, 0, 1;
+  ref.width = 64;
+  ref.height = 35;
+  const double end_on_depth = 1.0;  // label 16 of the labels below
+  StereoCamera end_on;              // at (2, 0, 1) looking along -x, on the line y = 0, z = 1
+  end_on.K << 64, 0, 32, 0, 64, 18, 0, 0, 1;
+  end_on.R << 0, 0, 1, 0, 1, 0, -1, 0, 0;
+  end_on.t = -end_on.R * Eigen::Vector3d(2, 0, end_on_depth);
+  end_on.width = 64;
+  end_on.height = 36;
+  const StereoCamera other = LookAtCamera({0.2, 0.1, 0}, {0, 0, 1}, 64, 64, 35);
+  CostViewInput ref_input(ref, RandomMap(64, 35, 2, 11));
+  const int row = 17, col = 40;
+  ref_input.field.At(row, col, 0) = 0.8f;  // a strand along the image's x axis
+  ref_input.field.At(row, col, 1) = 0.0f;
+  const std::vector<CostViewInput> with_end_on = {CostViewInput(end_on, RandomMap(64, 36, 2, 12)),
+                                                  CostViewInput(other, RandomMap(64, 35, 2, 13))};
+  const std::vector<CostViewInput> without_end_on = {with_end_on[1]};
+  const DepthLabels labels(0.5, 1.5, 33, false);
+  ASSERT_EQ(labels.Depth(16), end_on_depth);
+  const std::vector<float> base(64 * 35, 0.0f);
+  const auto cpu = [&](const std::vector<CostViewInput>& sources) {
+    return OrientationCostCpu(ref_input, sources, base, 1.0f, 12, 8, labels,
+                              OrientationTransfer::kPlaneHomography);
+  };
+  const FloatMap expected = cpu(with_end_on);
+  const FloatMap expected_without = cpu(without_end_on);
+  CostVolumeCL volume(context.get(), StereoCost::kOrientation, ref_input, with_end_on,
+                      OrientationTransfer::kPlaneHomography);
+  const FloatMap got = volume.Compute(base, 1.0f, 12, 8, labels);
+  EXPECT_LT(MaxAbsDiff(got, expected), 2e-4f);
+  // Slice 4 is label 16: the end-on source adds nothing there, and something at the labels
+  // beside it, where the piece has a direction.
+  EXPECT_EQ(expected.At(row, col, 4), expected_without.At(row, col, 4));
+  EXPECT_NEAR(got.At(row, col, 4), expected_without.At(row, col, 4), 2e-4f);
+  for (int k : {3, 5}) {
+    EXPECT_GT(std::abs(expected.At(row, col, k) - expected_without.At(row, col, k)), 1e-3f)
+        << "slice " << k;
+  }
+}
+
 TEST(CostVolume, PhotometricKernelsMatchTheCpuReference) {
   auto context = OpenCLContext::Create();
   const Scene scene = MakeScene(3);
