@@ -13,6 +13,7 @@
 // pictures of depths and normals.
 
 #include <algorithm>
+#include <map>
 #include <string>
 #include <utility>
 #include <vector>
@@ -570,7 +571,9 @@ struct OrientationStereoOptions {
     v("truncation_labels", &truncation_labels,
       "truncate the quadratic smoothness at this label difference (<= 0: none)");
     v("mrf_solver", &mrf_solver, kMrfSolverNameList);
-    v("mrf_max_cycles", &mrf_max_cycles, "MRF solver cycles / iterations");
+    v("mrf_max_cycles", &mrf_max_cycles,
+      "graph_cuts' expansion cycles, icm's sweeps (semi_global and belief_propagation do not "
+      "take it)");
     v("mrf_icm_polish_iterations", &mrf_icm_polish_iterations,
       "ICM sweeps polishing the MRF solver's labels (0: none)");
     v("coarse_level", &coarse_level,
@@ -653,6 +656,13 @@ struct OrientationStereoOptions {
   // The fields this stereo reads: `filter`'s with PyramidLevels() levels (what orientation
   // fields computed for it must be, to be reused).
   OrientationFieldOptions FieldOptions(const OrientationFieldOptions& filter) const;
+  // The --OrientationField options that FieldOptions sets, with why: a command that takes both
+  // sections adds these as ignored (OptionParser::AddSection), so giving one warns.
+  static std::map<std::string, std::string> FieldOptionsSetHere() {
+    return {{"num_levels",
+             "the stereo computes the fields' levels from --OrientationStereo.num_levels and "
+             "coarse_level"}};
+  }
   // The name of the maps a view ends with: "geometric" after the geometric pass, else
   // single_pass_type.
   std::string FinalMapType() const { return geom_consistency ? "geometric" : single_pass_type; }

@@ -69,7 +69,8 @@ int RunPipeline(int argc, char** argv) {
              "a synthetic data set's gt/ folder: evaluate depth maps and mesh at the end");
   parser.Add("write_png", &write_png, "write orientation, depth and normal pictures");
   parser.AddSection("OpenCL", &opencl_options);
-  parser.AddSection("OrientationField", &orientation_options);
+  parser.AddSection("OrientationField", &orientation_options,
+                    OrientationStereoOptions::FieldOptionsSetHere());
   parser.AddSection("OrientationStereo", &stereo_options);
   parser.AddSection("SourceViews", &source_options);
   parser.AddSection("TemplateFusion", &fusion_options);

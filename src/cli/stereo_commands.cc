@@ -44,7 +44,8 @@ int RunOrientationStereoCommand(int argc, char** argv) {
   parser.Add("write_png", &options.write_png, "also write coloured depth and normal pictures");
   parser.AddSection("OrientationStereo", &options);
   parser.AddSection("SourceViews", &source_options);
-  parser.AddSection("OrientationField", &field_options);
+  parser.AddSection("OrientationField", &field_options,
+                    OrientationStereoOptions::FieldOptionsSetHere());
   parser.AddSection("OpenCL", &opencl_options);
   if (!parser.Parse(argc, argv)) return 0;
   std::string error;
@@ -112,7 +113,8 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              "patch-match.cfg to use instead of stereo/patch-match.cfg (as colmap's)");
   parser.AddSection("OrientationStereo", &options);
   parser.AddSection("SourceViews", &source_options);
-  parser.AddSection("OrientationField", &field_options);
+  parser.AddSection("OrientationField", &field_options,
+                    OrientationStereoOptions::FieldOptionsSetHere());
   parser.AddSection("OpenCL", &opencl_options);
   const std::string kPatchMatchOnly = "PatchMatch-specific; orientation stereo has no such setting";
   for (const char* name :
@@ -143,7 +145,13 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   // Any case, as colmap takes it.
   THROW_IF(ToLower(workspace_format) != "colmap",
            "--workspace_format " << workspace_format << " is not supported (only COLMAP)");
-  if (parser.WasGiven("config_path")) source_options.config_path = config_path;
+  THROW_IF(parser.WasGiven("config_path") && !parser.FromProjectFile("config_path") &&
+               parser.WasGiven("SourceViews.config_path"),
+           "hairmvs patch_match_stereo: --config_path and --SourceViews.config_path set the "
+           "same file: give one or the other");
+  if (parser.WasGiven("config_path") && !parser.WasGiven("SourceViews.config_path")) {
+    source_options.config_path = config_path;
+  }
   // colmap's options and the fields they set: applied where given, and named in the error
   // when a value they set is refused. `colmap_default`: colmap's default where hairmvs's own
   // differs on purpose (OrientationStereoOptions says why), NaN elsewhere.
@@ -185,12 +193,16 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   //   hairmvs's differ on purpose, colmap's from the file are left to them (given on the
   //   command line they apply);
   // - the command line wins over the file: a file's value is not applied over the hairmvs
-  //   option it sets when that option is given.
+  //   option it sets when that option is given;
+  // - both given on the command line is an error: which one was meant is not ours to guess.
   std::vector<std::string> left_to_hairmvs, overridden;
   for (const MappedOption& option : mapped) {
     if (!parser.WasGiven(option.colmap_name)) continue;
     const bool from_file = parser.FromProjectFile(option.colmap_name);
     const std::string own = std::string(option.section) + "." + option.field;
+    THROW_IF(!from_file && parser.WasGiven(own) && !parser.FromProjectFile(own),
+             "hairmvs patch_match_stereo: --" << option.colmap_name << " and --" << own
+                                             << " set the same option: give one or the other");
     if (from_file && option.value == option.colmap_default) {
       left_to_hairmvs.push_back(option.colmap_name);
     } else if (from_file && parser.WasGiven(own)) {

@@ -62,7 +62,8 @@ int RunWorkspaceInfo(int argc, char** argv) {
   parser.Add("mask_path", &mask_path,
              "folder of masks <image name>.png (default: <workspace>/masks if present)");
   parser.AddSection("SourceViews", &options);
-  parser.AddSection("OrientationField", &field_options);
+  parser.AddSection("OrientationField", &field_options,
+                    OrientationStereoOptions::FieldOptionsSetHere());
   OrientationStereoOptions stereo_options;
   parser.Add("max_image_size", &stereo_options.max_image_size,
              "check the orientation fields the stereo caches at this size (-1: full size, as "

@@ -201,9 +201,18 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
       } catch (const po::error& e) {
         HAIRMVS_THROW("--project_path " << path << ": " << e.what());
       }
-      // The file's options that take effect, and those of our sections without effect (named
-      // once here, rather than warned about one by one: a generated file lists them all).
-      std::vector<std::string> used;
+      // The sections of this command's own options (--Section.field): a key the file gives
+      // there that is none of them is a typo, refused as the command line refuses it.
+      std::set<std::string> own_sections;
+      for (const std::string& name : impl_->names) {
+        const size_t dot = name.find('.');
+        if (dot != std::string::npos) own_sections.insert(name.substr(0, dot));
+      }
+      // The file's options that take effect, and those of colmap's sections without effect
+      // (named once here, rather than warned about one by one: a generated file lists them
+      // all). A colmap section's key unknown here may be a typo or an option of another colmap
+      // version: named apart.
+      std::vector<std::string> used, unknown_own, unknown_colmap;
       for (const po::option& option : from_file.options) {
         const std::string& key = option.string_key;
         // Given on the command line (the file's values are not stored yet): that value wins.
@@ -211,13 +220,20 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
         if (!option.unregistered && impl_->ignored.count(key) == 0) {
           used.push_back(key + "=" + (option.value.empty() ? "" : option.value.front()));
           impl_->from_project_file.insert(key);
-        } else if (impl_->ignored.count(key) > 0 ||
-                   InSections(key, impl_->project_sections)) {
-          // Ignored here (colmap's top-level log_level too), or unknown in our sections; other
-          // commands' sections are passed over.
-          not_used.push_back(key);
+        } else if (impl_->ignored.count(key) > 0) {
+          not_used.push_back(key);  // ignored here (colmap's top-level log_level too)
+        } else if (InSections(key, impl_->project_sections)) {
+          unknown_colmap.push_back(key);
+        } else if (key.find('.') != std::string::npos &&
+                   own_sections.count(key.substr(0, key.find('.'))) > 0) {
+          unknown_own.push_back(key);
         }
+        // Other commands' sections are passed over.
       }
+      THROW_IF(!unknown_own.empty(),
+               "--project_path " << path << ": unknown option" << (unknown_own.size() > 1 ? "s" : "")
+                                 << " " << JoinStrings(unknown_own, ", ") << " (see hairmvs "
+                                 << impl_->command << " -h)");
       po::store(from_file, impl_->vm);
       LOG(INFO) << path << ": options read from it: "
                 << (used.empty() ? "none" : JoinStrings(used, ", "));
@@ -225,6 +241,11 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
         LOG(WARNING) << path << ": " << not_used.size() << " of its options have no effect "
                      << "in hairmvs (see hairmvs " << impl_->command
                      << " -h for why): " << JoinStrings(not_used, ", ");
+      }
+      if (!unknown_colmap.empty()) {
+        LOG(WARNING) << path << ": " << unknown_colmap.size() << " of its options are unknown "
+                     << "to hairmvs and colmap 3.8 (a typo, or another colmap version's?), "
+                     << "not applied: " << JoinStrings(unknown_colmap, ", ");
       }
     }
     po::notify(impl_->vm);

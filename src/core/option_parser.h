@@ -19,6 +19,7 @@
 // `std::string ToString(E)` and `bool FromString(const std::string&, E*)` found by ADL.
 
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <type_traits>
@@ -49,12 +50,21 @@ class OptionParser {
         [value] { return ToString(*value); });
   }
 
-  // Adds every field of an options struct as `--Section.field`.
+  // Adds every field of an options struct as `--Section.field`, except those of
+  // `ignored_fields` (field -> why), which another of the command's options decides: those are
+  // added as AddIgnored, so that giving one warns rather than silently doing nothing.
   template <typename OptionsT>
-  void AddSection(const std::string& section, OptionsT* options) {
-    options->ForEachField([this, &section](const char* field, auto* ptr, const char* help) {
-      Add(section + "." + field, ptr, help);
-    });
+  void AddSection(const std::string& section, OptionsT* options,
+                  const std::map<std::string, std::string>& ignored_fields = {}) {
+    options->ForEachField(
+        [this, &section, &ignored_fields](const char* field, auto* ptr, const char* help) {
+          const auto ignored = ignored_fields.find(field);
+          if (ignored != ignored_fields.end()) {
+            AddIgnored(section + "." + field, ignored->second);
+          } else {
+            Add(section + "." + field, ptr, help);
+          }
+        });
   }
 
   // An option accepted for compatibility (e.g. one of colmap patch_match_stereo's) but
@@ -64,9 +74,10 @@ class OptionParser {
   // `--project_path FILE`, as every colmap command takes it: an .ini file of options
   // (`key=value` at the top, `[Section]` then `key=value` for `--Section.key`), as colmap
   // project_generator and colmap's GUI write it. Options given on the command line win over
-  // the file's; the file's sections for other commands are passed over, and its options of
-  // `sections` that are ignored here or unknown are named in one warning. A missing or
-  // malformed file is an error naming it.
+  // the file's; the file's sections for other commands are passed over, its options of
+  // `sections` (colmap's) that are ignored here are named in one warning and those unknown in
+  // another, and an unknown key in a section of the command's own options (a typo) is an
+  // error. A missing or malformed file is an error naming it.
   void AddProjectPath(const std::vector<std::string>& sections);
   // Parses argv[first..argc). Returns false when help was requested (and printed).
   // Throws hairmvs::Error on an unknown option, a missing value or a bad value.

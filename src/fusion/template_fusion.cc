@@ -79,9 +79,15 @@ bool TemplateFusionOptions::Check(std::string* error) const {
                "TemplateFusion.trim_min_sample_spacings must be >= 0");
   CHECK_OPTION(min_component_fraction >= 0 && min_component_fraction <= 1,
                "TemplateFusion.min_component_fraction must be in [0, 1]");
-  CHECK_OPTION(target_edge_length_px > 0, "TemplateFusion.target_edge_length_px must be > 0");
-  CHECK_OPTION(max_mesh_vertices >= 100, "TemplateFusion.max_mesh_vertices must be >= 100");
-  CHECK_OPTION(node_spacing_cells > 0, "TemplateFusion.node_spacing_cells must be > 0");
+  // The subdivision stops at max_mesh_vertices, whatever the edge length asks for; 2e7
+  // vertices take a few GiB with their fit terms.
+  CHECK_OPTION(target_edge_length_px >= 0.1,
+               "TemplateFusion.target_edge_length_px must be >= 0.1");
+  CHECK_OPTION(max_mesh_vertices >= 100 && max_mesh_vertices <= 20000000,
+               "TemplateFusion.max_mesh_vertices must be in [100, 2e7]");
+  // The graph's nodes grow with 1 / spacing^2: a quarter cell is already 100 times the default's.
+  CHECK_OPTION(node_spacing_cells >= 0.25 && node_spacing_cells <= 1000,
+               "TemplateFusion.node_spacing_cells must be in [0.25, 1000]");
   CHECK_OPTION(num_node_neighbors >= 1 && num_node_neighbors <= 8,
                "TemplateFusion.num_node_neighbors must be in [1, 8]");
   CHECK_OPTION(num_rounds >= 0 && num_rounds <= 100,
@@ -92,8 +98,10 @@ bool TemplateFusionOptions::Check(std::string* error) const {
   CHECK_OPTION(regularization_decay > 0 && regularization_decay <= 1,
                "TemplateFusion.regularization_decay must be in (0, 1]");
   CHECK_OPTION(max_fit_distance_cells > 0, "TemplateFusion.max_fit_distance_cells must be > 0");
-  CHECK_OPTION(max_fit_vertices >= 1, "TemplateFusion.max_fit_vertices must be >= 1");
-  CHECK_OPTION(max_solver_iterations >= 1, "TemplateFusion.max_solver_iterations must be >= 1");
+  CHECK_OPTION(max_fit_vertices >= 1 && max_fit_vertices <= 20000000,
+               "TemplateFusion.max_fit_vertices must be in [1, 2e7]");
+  CHECK_OPTION(max_solver_iterations >= 1 && max_solver_iterations <= 1000,
+               "TemplateFusion.max_solver_iterations must be in [1, 1000]");
   CHECK_OPTION(max_detail_offset_cells >= 0,
                "TemplateFusion.max_detail_offset_cells must be >= 0");
   CHECK_OPTION(max_detail_view_angle_deg > 0 && max_detail_view_angle_deg < 90,

@@ -53,14 +53,25 @@ TEST(TemplateFusion, OptionsCheck) {
   options = TemplateFusionOptions();
   options.input_type = "fancy";
   EXPECT_FALSE(options.Check(&error));
-  // Upper bounds: a thread count that crashed OpenMP, rounds that ran for hours, a Poisson box
-  // or voxel that leaves nothing to fuse.
+  // Bounds: a thread count that crashed OpenMP, rounds that ran for hours, a Poisson box or
+  // voxel that leaves nothing to fuse, sizes that run out of memory after the maps are read.
   const std::vector<std::pair<std::function<void(TemplateFusionOptions*)>, std::string>> cases = {
       {[](TemplateFusionOptions* o) { o->num_threads = 257; }, "num_threads must be in [1, 256]"},
       {[](TemplateFusionOptions* o) { o->num_rounds = 101; }, "num_rounds must be in [0, 100]"},
       {[](TemplateFusionOptions* o) { o->poisson_scale = 4.5; }, "poisson_scale must be in [1, 4]"},
       {[](TemplateFusionOptions* o) { o->fused_voxel_size_px = 101; },
-       "fused_voxel_size_px must be in (0, 100]"}};
+       "fused_voxel_size_px must be in (0, 100]"},
+      // A mesh or a graph too large for memory, asked for by a tiny edge or node spacing.
+      {[](TemplateFusionOptions* o) { o->max_mesh_vertices = 2000000000; },
+       "max_mesh_vertices must be in [100, 2e7]"},
+      {[](TemplateFusionOptions* o) { o->target_edge_length_px = 1e-6; },
+       "target_edge_length_px must be >= 0.1"},
+      {[](TemplateFusionOptions* o) { o->node_spacing_cells = 1e-9; },
+       "node_spacing_cells must be in [0.25, 1000]"},
+      {[](TemplateFusionOptions* o) { o->max_fit_vertices = 2000000000; },
+       "max_fit_vertices must be in [1, 2e7]"},
+      {[](TemplateFusionOptions* o) { o->max_solver_iterations = 100000; },
+       "max_solver_iterations must be in [1, 1000]"}};
   for (const auto& [edit, expected] : cases) {
     options = TemplateFusionOptions();
     edit(&options);

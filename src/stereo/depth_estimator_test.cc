@@ -388,6 +388,19 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
   options = OrientationStereoOptions();
   options.geom_consistency_iterations = 0;
   ExpectRefusedNaming(options, "geom_consistency_iterations");
+  // Weights that overflow the MRF's float costs (inf, or 0 * inf = NaN for sigma_o): each
+  // had run a view and failed inside the MRF, or written empty maps, without naming it.
+  for (const auto& [edit, name] :
+       std::vector<std::pair<std::function<void(OrientationStereoOptions*)>, std::string>>{
+           {[](OrientationStereoOptions* o) { o->lambda = 1e39; }, "lambda must be in [0, 1e6]"},
+           {[](OrientationStereoOptions* o) { o->sigma_o = 1e-200; },
+            "sigma_o must be in [1e-6, 1e6]"},
+           {[](OrientationStereoOptions* o) { o->geom_prior_weight = 1e39; },
+            "geom_prior_weight must be in [0, 1e6]"}}) {
+    options = OrientationStereoOptions();
+    edit(&options);
+    ExpectRefusedNaming(options, name);
+  }
   options = OrientationStereoOptions();
   options.geom_consistency_min_inconsistent_fraction = 1.5;
   ExpectRefusedNaming(options, "geom_consistency_min_inconsistent_fraction");

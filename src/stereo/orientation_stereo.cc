@@ -153,7 +153,11 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (num_depths < 3 || num_depths > 4096) e << "num_depths must be in [3, 4096]; ";
   if (!(visual_hull_tolerance_m >= 0)) e << "visual_hull_tolerance_m must be >= 0; ";
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
-  if (!(geom_prior_weight >= 0)) e << "geom_prior_weight must be >= 0; ";
+  // Upper bounds on weights (and a lower one on sigma_o): the MRF's costs are floats, which
+  // overflow (or divide 0 by 0) long before a double does.
+  if (!(geom_prior_weight >= 0 && geom_prior_weight <= 1e6)) {
+    e << "geom_prior_weight must be in [0, 1e6]; ";
+  }
   if (!(geom_prior_max_error_px > 0)) e << "geom_prior_max_error_px must be > 0; ";
   if (geom_consistency_iterations < 1) e << "geom_consistency_iterations must be >= 1; ";
   if (!(geom_consistency_max_view_angle_deg >= 0 && geom_consistency_max_view_angle_deg <= 180)) {
@@ -208,8 +212,8 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(min_confidence >= 0)) e << "min_confidence must be >= 0; ";
   // Beyond ~1e3 the guide's squares overflow float in the guided filter: every map empty.
   if (!(guide_rms >= 0 && guide_rms <= 1000)) e << "guide_rms must be in [0, 1000]; ";
-  if (!(sigma_o > 0)) e << "sigma_o must be > 0; ";
-  if (!(lambda >= 0)) e << "lambda must be >= 0; ";
+  if (!(sigma_o >= 1e-6 && sigma_o <= 1e6)) e << "sigma_o must be in [1e-6, 1e6]; ";
+  if (!(lambda >= 0 && lambda <= 1e6)) e << "lambda must be in [0, 1e6]; ";
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
   if (mrf_icm_polish_iterations < 0) e << "mrf_icm_polish_iterations must be >= 0; ";

@@ -217,9 +217,14 @@ TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
         ReadMat(JoinPaths(workspace, "stereo", "depth_maps", "g0_c.png." + type + ".bin"));
     return std::count_if(map.Data().begin(), map.Data().end(), [](float d) { return d > 0; });
   };
-  output = RunHairmvs(run + " --log_to_stderr 1 --random_seed 3");
+  // The stereo sets the fields' levels itself: the field option that would do it warns.
+  output = RunHairmvs(run + " --log_to_stderr 1 --random_seed 3 --OrientationField.num_levels 2");
   ASSERT_EQ(output.exit_code, 0) << output.text;
   EXPECT_NE(output.text.find("log_to_stderr"), std::string::npos) << output.text;
+  EXPECT_NE(output.text.find("--OrientationField.num_levels is ignored by hairmvs: the stereo "
+                             "computes the fields' levels from --OrientationStereo.num_levels"),
+            std::string::npos)
+      << output.text;
   const long filtered = num_depths("geometric");
   output = RunHairmvs(run + " --PatchMatchStereo.filter 0");
   ASSERT_EQ(output.exit_code, 0) << output.text;
@@ -230,6 +235,21 @@ TEST(Cli, PatchMatchStereoTakesColmapsOptions) {
   output = RunHairmvs(run + " --PatchMatchStereo.filter 0 --OrientationStereo.min_confidence 0.1");
   EXPECT_NE(output.exit_code, 0);
   EXPECT_NE(output.text.find("--OrientationStereo.min_confidence filters them"), std::string::npos)
+      << output.text;
+  // A colmap option and the hairmvs option it sets, both on the command line: refused before
+  // any work, rather than one silently winning.
+  output = RunHairmvs(run + " --PatchMatchStereo.max_image_size 100 "
+                            "--OrientationStereo.max_image_size 50");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--PatchMatchStereo.max_image_size and "
+                             "--OrientationStereo.max_image_size set the same option: give one "
+                             "or the other"),
+            std::string::npos)
+      << output.text;
+  output = RunHairmvs(run + " --config_path a.cfg --SourceViews.config_path b.cfg");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find("--config_path and --SourceViews.config_path set the same file"),
+            std::string::npos)
       << output.text;
   output = RunHairmvs(run + " --PatchMatchStereo.max_image_size 0");
   EXPECT_NE(output.exit_code, 0);
