@@ -2,10 +2,75 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 
 #include "src/core/logging.h"
 
 namespace hairmvs {
+void SmoothDetailOffsets(const FusionMesh& mesh, double weight, std::vector<double>* offsets) {
+  const int n = static_cast<int>(offsets->size());
+  std::vector<Eigen::Triplet<double>> entries;
+  Eigen::VectorXd rhs = Eigen::VectorXd::Zero(n);
+  for (int i = 0; i < n; ++i) {
+    if (std::isnan((*offsets)[i])) continue;
+    entries.emplace_back(i, i, 1.0);
+    rhs[i] = (*offsets)[i];
+  }
+  // Each edge once, however many faces share it.
+  std::vector<std::pair<int, int>> edges;
+  for (const Eigen::Vector3i& face : mesh.faces) {
+    for (int k = 0; k < 3; ++k) {
+      edges.emplace_back(std::minmax(face[k], face[(k + 1) % 3]));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  std::vector<bool> reached(n, false);  // whether the vertex's part of the mesh has a target
+  for (const auto& [a, b] : edges) {
+    entries.emplace_back(a, a, weight);
+    entries.emplace_back(b, b, weight);
+    entries.emplace_back(a, b, -weight);
+    entries.emplace_back(b, a, -weight);
+  }
+  // A part of the mesh without targets would make the system singular: a pull to 0 too weak
+  // to move the others keeps it solvable; its vertices are given NaN back below.
+  for (int i = 0; i < n; ++i) entries.emplace_back(i, i, 1e-9);
+  Eigen::SparseMatrix<double> system(n, n);
+  system.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(system);
+  if (solver.info() != Eigen::Success) {
+    LOG(WARNING) << "detail: the offsets' system failed to factorise; per-vertex medians kept";
+    return;
+  }
+  const Eigen::VectorXd solved = solver.solve(rhs);
+  // The parts reached from a vertex with a target, by the edges.
+  std::vector<std::vector<int>> neighbours(n);
+  for (const auto& [a, b] : edges) {
+    neighbours[a].push_back(b);
+    neighbours[b].push_back(a);
+  }
+  std::vector<int> stack;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isnan((*offsets)[i]) && !reached[i]) {
+      reached[i] = true;
+      stack.push_back(i);
+    }
+  }
+  while (!stack.empty()) {
+    const int i = stack.back();
+    stack.pop_back();
+    for (int j : neighbours[i]) {
+      if (!reached[j]) {
+        reached[j] = true;
+        stack.push_back(j);
+      }
+    }
+  }
+  for (int i = 0; i < n; ++i) (*offsets)[i] = reached[i] ? solved[i] : std::nan("");
+}
 
 DetailStats TransferDetail(const std::vector<FusionView>& views,
                            const TemplateFusionOptions& options, double cell_m,
@@ -36,6 +101,9 @@ DetailStats TransferDetail(const std::vector<FusionView>& views,
     double median = s[mid];
     if (s.size() % 2 == 0) median = 0.5 * (median + *std::max_element(s.begin(), s.begin() + mid));
     offsets[i] = median;
+  }
+  if (options.detail_smoothness_weight > 0) {
+    SmoothDetailOffsets(*mesh, options.detail_smoothness_weight, &offsets);
   }
   DetailStats stats;
   std::vector<double> magnitudes;

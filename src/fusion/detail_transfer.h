@@ -20,10 +20,17 @@ struct DetailStats {
 // v; if that surface is locally parallel to the template, the offset along n that reaches it
 // is s = (q - v) . n (the line of sight crosses the offset plane at q). The vertex moves by
 // the median of s over the views (|s| <= max_detail_offset_cells), robust to a view that
-// sees another layer.
+// sees another layer; with detail_smoothness_weight > 0, those medians are the targets of
+// SmoothDetailOffsets.
 DetailStats TransferDetail(const std::vector<FusionView>& views,
                            const TemplateFusionOptions& options, double cell_m,
                            FusionMesh* mesh);
+
+// The offsets as one linear least-squares problem (TemplateFusionOptions::
+// detail_smoothness_weight): minimises sum_i (s_i - t_i)^2 over the vertices with a target t_i
+// (*offsets[i], NaN where none) plus `weight` times sum (s_i - s_j)^2 over the mesh's edges, and
+// writes s into *offsets. A vertex with no target in its part of the mesh stays NaN.
+void SmoothDetailOffsets(const FusionMesh& mesh, double weight, std::vector<double>* offsets);
 
 // Vertex colours: the mean over the views that see a vertex (facing it, depth agreeing
 // within visibility_depth_tolerance), weighted by the cosine of the viewing angle. Grey

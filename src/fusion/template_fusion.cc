@@ -104,6 +104,8 @@ bool TemplateFusionOptions::Check(std::string* error) const {
                "TemplateFusion.max_solver_iterations must be in [1, 1000]");
   CHECK_OPTION(max_detail_offset_cells >= 0,
                "TemplateFusion.max_detail_offset_cells must be >= 0");
+  CHECK_OPTION(detail_smoothness_weight >= 0 && detail_smoothness_weight <= 1e6,
+               "TemplateFusion.detail_smoothness_weight must be in [0, 1e6]");
   CHECK_OPTION(max_detail_view_angle_deg > 0 && max_detail_view_angle_deg < 90,
                "TemplateFusion.max_detail_view_angle_deg must be in (0, 90)");
   CHECK_OPTION(num_threads >= 1 && num_threads <= 256,

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <set>
 
 #include "src/core/test_util.h"
+#include "src/fusion/detail_transfer.h"
 #include "src/fusion/fusion_points.h"
 #include "src/fusion/fusion_test_scenes.h"
 #include "src/fusion/template_fusion_core.h"
@@ -204,6 +206,66 @@ TEST(TemplateFusion, DetailRestoresHighFrequencies) {
   EXPECT_GT(out.detail.num_vertices_with_detail,
             static_cast<int>(out.final_mesh.vertices.size() / 2));
   EXPECT_LT(final_error.rms, 0.7 * refined.rms);
+}
+
+// The detail's linear least-squares offsets (detail_smoothness_weight): on a grid of 6 x 4
+// vertices with targets on some, the result satisfies the problem's normal equations, those
+// without a target take values between their neighbours' (the maximum principle: not 0), and a
+// separate part of the mesh without any target stays NaN.
+TEST(TemplateFusion, SmoothDetailOffsetsSolvesTheLeastSquaresProblem) {
+  FusionMesh mesh;
+  const int cols = 6, rows = 4;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) mesh.vertices.emplace_back(c, r, 0);
+  }
+  for (int r = 0; r + 1 < rows; ++r) {
+    for (int c = 0; c + 1 < cols; ++c) {
+      const int v = r * cols + c;
+      mesh.faces.emplace_back(v, v + 1, v + cols + 1);
+      mesh.faces.emplace_back(v, v + cols + 1, v + cols);
+    }
+  }
+  // A lone triangle apart from the grid.
+  const int lone = static_cast<int>(mesh.vertices.size());
+  for (int k = 0; k < 3; ++k) mesh.vertices.emplace_back(10 + k, 10, 0);
+  mesh.faces.emplace_back(lone, lone + 1, lone + 2);
+  const double nan = std::nan("");
+  std::vector<double> targets(mesh.vertices.size(), nan);
+  for (int r = 0; r < rows; ++r) {
+    targets[r * cols] = 0.001 * r;             // the left column
+    targets[r * cols + cols - 1] = 0.004 + 0.001 * r;  // the right one
+  }
+  targets[2 * cols + 2] = 0.010;  // one inside, above both
+  const double weight = 0.7;
+  std::vector<double> offsets = targets;
+  SmoothDetailOffsets(mesh, weight, &offsets);
+  // The normal equations: w_i (s_i - t_i) + weight * sum over i's edges (s_i - s_j) = 0.
+  std::vector<std::set<int>> neighbours(mesh.vertices.size());
+  for (const Eigen::Vector3i& f : mesh.faces) {
+    for (int k = 0; k < 3; ++k) {
+      neighbours[f[k]].insert(f[(k + 1) % 3]);
+      neighbours[f[(k + 1) % 3]].insert(f[k]);
+    }
+  }
+  for (int i = 0; i < rows * cols; ++i) {
+    double gradient = std::isnan(targets[i]) ? 0.0 : offsets[i] - targets[i];
+    for (int j : neighbours[i]) gradient += weight * (offsets[i] - offsets[j]);
+    EXPECT_NEAR(gradient, 0.0, 1e-9) << "vertex " << i;
+    if (std::isnan(targets[i])) {
+      double lo = 1, hi = -1;
+      for (int j : neighbours[i]) {
+        lo = std::min(lo, offsets[j]);
+        hi = std::max(hi, offsets[j]);
+      }
+      EXPECT_GT(offsets[i], 0.0) << "vertex " << i;
+      EXPECT_GE(offsets[i], lo - 1e-12) << "vertex " << i;
+      EXPECT_LE(offsets[i], hi + 1e-12) << "vertex " << i;
+    }
+  }
+  // A target is pulled towards its neighbours, not kept: the inner one lies above them all.
+  EXPECT_LT(offsets[2 * cols + 2], 0.010);
+  EXPECT_GT(offsets[2 * cols + 2], offsets[2 * cols + 1]);
+  for (int k = 0; k < 3; ++k) EXPECT_TRUE(std::isnan(offsets[lone + k]));
 }
 
 }  // namespace
