@@ -335,6 +335,15 @@ struct OrientationStereoOptions {
   // mm (mean 23.96 -> 17.81, 3D mean 6.35 -> 4.27 mm), 58.7 -> 57.6% of the hair; first
   // estimates 29.12 -> 16.74 mm; synth_straight_gantry, 32 views (10 degree baselines): the
   // same (4.73 mm, 97.4%, 3D median 0.573 -> 0.577 mm); the curly demo group 2.39 -> 2.39 mm.
+  // With normalised fields (orientation_normalization_radius_px > 0) the phase carried is the
+  // normalised field's, the pixel's deviation from its window's mean, which is no strand's
+  // direction; the homography is not a rotation, so carrying it differs from turning the
+  // normalised field by the angle the raw strand turns by. That alternative (a prototype,
+  // measured at stop 57, tested against the CPU reference: the raw field's phase carried and
+  // the normalised field turned with it) did not help: synth_handheld 93.0% / 9.79 / 4.69 /
+  // 1.183 / 0.558 mm -> 92.8% / 9.73 / 4.69 / 1.196 / 0.551 (first estimates 6.97 -> 7.30 mm,
+  // the data term alone 10.88 -> 11.67 mm), synth_straight_gantry 98.7% / 7.93 / 4.17 / 1.024 /
+  // 0.527 -> 98.7% / 7.99 / 4.18 / 1.034 / 0.523 (complete / mean / median / 3D mean / 3D median).
   OrientationTransfer orientation_transfer = OrientationTransfer::kPlaneHomography;
   // The plane a strand is taken to lie in by plane_homography. With masks: parallel to the
   // masks' visual hull where the pixel's ray enters it (hair is what makes the silhouettes, so

@@ -118,8 +118,11 @@ void ResolveIncludesInText(const std::string& file, const std::string& text,
 
 // What to do when the device is out of memory: the end of both messages that say so.
 constexpr const char* kOpenCLOutOfMemoryAdvice =
-    "a smaller --OrientationStereo.max_image_size, or --OpenCL.device of another device "
-    "(`hairmvs opencl_devices` lists each device's memory and largest allocation)";
+    "smaller images (--OrientationStereo.max_image_size; orientation_fields' --max_image_size), "
+    "fewer depth slices per block on the device (--OrientationStereo.slice_block: the guided "
+    "filter's and the colour cost's largest buffers grow with it), or --OpenCL.device of "
+    "another device (`hairmvs opencl_devices` lists each device's memory and largest "
+    "allocation)";
 
 std::string DescribeException(const std::exception& e) {
   const auto* error = dynamic_cast<const cl::Error*>(&e);
@@ -128,10 +131,16 @@ std::string DescribeException(const std::exception& e) {
   message << "OpenCL call " << error->what() << " failed: " << OpenCLErrorString(error->err());
   switch (error->err()) {
     case CL_MEM_OBJECT_ALLOCATION_FAILURE:
-    case CL_OUT_OF_RESOURCES:
     case CL_OUT_OF_HOST_MEMORY:
     case CL_INVALID_BUFFER_SIZE:
       message << ": the device ran out of memory, or a buffer exceeds its largest allocation; "
+              << kOpenCLOutOfMemoryAdvice;
+      break;
+    case CL_OUT_OF_RESOURCES:
+      // GPU drivers (NVIDIA's) also report a kernel that failed (an access out of bounds) or
+      // was stopped by the display's watchdog so.
+      message << ": the device ran out of memory or other resources, or a kernel failed or "
+                 "was stopped (a GPU that also drives a display stops long kernels); if memory, "
               << kOpenCLOutOfMemoryAdvice;
       break;
     default:
@@ -143,33 +152,73 @@ std::string DescribeException(const std::exception& e) {
 std::string OpenCLErrorString(cl_int code) {
   const char* name = "unknown error";
   switch (code) {
-    case CL_SUCCESS: name = "CL_SUCCESS"; break;
-    case CL_DEVICE_NOT_FOUND: name = "CL_DEVICE_NOT_FOUND"; break;
-    case CL_DEVICE_NOT_AVAILABLE: name = "CL_DEVICE_NOT_AVAILABLE"; break;
-    case CL_COMPILER_NOT_AVAILABLE: name = "CL_COMPILER_NOT_AVAILABLE"; break;
-    case CL_MEM_OBJECT_ALLOCATION_FAILURE: name = "CL_MEM_OBJECT_ALLOCATION_FAILURE"; break;
-    case CL_OUT_OF_RESOURCES: name = "CL_OUT_OF_RESOURCES"; break;
-    case CL_OUT_OF_HOST_MEMORY: name = "CL_OUT_OF_HOST_MEMORY"; break;
-    case CL_BUILD_PROGRAM_FAILURE: name = "CL_BUILD_PROGRAM_FAILURE"; break;
-    case CL_INVALID_VALUE: name = "CL_INVALID_VALUE"; break;
-    case CL_INVALID_PLATFORM: name = "CL_INVALID_PLATFORM"; break;
-    case CL_INVALID_DEVICE: name = "CL_INVALID_DEVICE"; break;
-    case CL_INVALID_CONTEXT: name = "CL_INVALID_CONTEXT"; break;
-    case CL_INVALID_COMMAND_QUEUE: name = "CL_INVALID_COMMAND_QUEUE"; break;
-    case CL_INVALID_MEM_OBJECT: name = "CL_INVALID_MEM_OBJECT"; break;
-    case CL_INVALID_BUILD_OPTIONS: name = "CL_INVALID_BUILD_OPTIONS"; break;
-    case CL_INVALID_PROGRAM: name = "CL_INVALID_PROGRAM"; break;
-    case CL_INVALID_KERNEL_NAME: name = "CL_INVALID_KERNEL_NAME"; break;
-    case CL_INVALID_KERNEL_ARGS: name = "CL_INVALID_KERNEL_ARGS"; break;
-    case CL_INVALID_ARG_INDEX: name = "CL_INVALID_ARG_INDEX"; break;
-    case CL_INVALID_ARG_VALUE: name = "CL_INVALID_ARG_VALUE"; break;
-    case CL_INVALID_ARG_SIZE: name = "CL_INVALID_ARG_SIZE"; break;
-    case CL_INVALID_WORK_DIMENSION: name = "CL_INVALID_WORK_DIMENSION"; break;
-    case CL_INVALID_WORK_GROUP_SIZE: name = "CL_INVALID_WORK_GROUP_SIZE"; break;
-    case CL_INVALID_WORK_ITEM_SIZE: name = "CL_INVALID_WORK_ITEM_SIZE"; break;
-    case CL_INVALID_GLOBAL_WORK_SIZE: name = "CL_INVALID_GLOBAL_WORK_SIZE"; break;
-    case CL_INVALID_BUFFER_SIZE: name = "CL_INVALID_BUFFER_SIZE"; break;
+#define X(CODE)    \
+  case CODE:       \
+    name = #CODE;  \
+    break;
+    // Every code of OpenCL 1.2's cl.h.
+    X(CL_SUCCESS)
+    X(CL_DEVICE_NOT_FOUND)
+    X(CL_DEVICE_NOT_AVAILABLE)
+    X(CL_COMPILER_NOT_AVAILABLE)
+    X(CL_MEM_OBJECT_ALLOCATION_FAILURE)
+    X(CL_OUT_OF_RESOURCES)
+    X(CL_OUT_OF_HOST_MEMORY)
+    X(CL_PROFILING_INFO_NOT_AVAILABLE)
+    X(CL_MEM_COPY_OVERLAP)
+    X(CL_IMAGE_FORMAT_MISMATCH)
+    X(CL_IMAGE_FORMAT_NOT_SUPPORTED)
+    X(CL_BUILD_PROGRAM_FAILURE)
+    X(CL_MAP_FAILURE)
+    X(CL_MISALIGNED_SUB_BUFFER_OFFSET)
+    X(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST)
+    X(CL_COMPILE_PROGRAM_FAILURE)
+    X(CL_LINKER_NOT_AVAILABLE)
+    X(CL_LINK_PROGRAM_FAILURE)
+    X(CL_DEVICE_PARTITION_FAILED)
+    X(CL_KERNEL_ARG_INFO_NOT_AVAILABLE)
+    X(CL_INVALID_VALUE)
+    X(CL_INVALID_DEVICE_TYPE)
+    X(CL_INVALID_PLATFORM)
+    X(CL_INVALID_DEVICE)
+    X(CL_INVALID_CONTEXT)
+    X(CL_INVALID_QUEUE_PROPERTIES)
+    X(CL_INVALID_COMMAND_QUEUE)
+    X(CL_INVALID_HOST_PTR)
+    X(CL_INVALID_MEM_OBJECT)
+    X(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR)
+    X(CL_INVALID_IMAGE_SIZE)
+    X(CL_INVALID_SAMPLER)
+    X(CL_INVALID_BINARY)
+    X(CL_INVALID_BUILD_OPTIONS)
+    X(CL_INVALID_PROGRAM)
+    X(CL_INVALID_PROGRAM_EXECUTABLE)
+    X(CL_INVALID_KERNEL_NAME)
+    X(CL_INVALID_KERNEL_DEFINITION)
+    X(CL_INVALID_KERNEL)
+    X(CL_INVALID_ARG_INDEX)
+    X(CL_INVALID_ARG_VALUE)
+    X(CL_INVALID_ARG_SIZE)
+    X(CL_INVALID_KERNEL_ARGS)
+    X(CL_INVALID_WORK_DIMENSION)
+    X(CL_INVALID_WORK_GROUP_SIZE)
+    X(CL_INVALID_WORK_ITEM_SIZE)
+    X(CL_INVALID_GLOBAL_OFFSET)
+    X(CL_INVALID_EVENT_WAIT_LIST)
+    X(CL_INVALID_EVENT)
+    X(CL_INVALID_OPERATION)
+    X(CL_INVALID_GL_OBJECT)
+    X(CL_INVALID_BUFFER_SIZE)
+    X(CL_INVALID_MIP_LEVEL)
+    X(CL_INVALID_GLOBAL_WORK_SIZE)
+    X(CL_INVALID_PROPERTY)
+    X(CL_INVALID_IMAGE_DESCRIPTOR)
+    X(CL_INVALID_COMPILER_OPTIONS)
+    X(CL_INVALID_LINKER_OPTIONS)
+    X(CL_INVALID_DEVICE_PARTITION_COUNT)
+#undef X
     case -1001: name = "CL_PLATFORM_NOT_FOUND_KHR (no OpenCL driver installed)"; break;
+    case -9999: name = "NVIDIA driver error (a kernel's access out of bounds?)"; break;
     default: break;
   }
   return std::string(name) + " (" + std::to_string(code) + ")";

@@ -120,17 +120,25 @@ TEST(OpenCLContext, BuildFailureThrowsWithLog) {
 // exceptions by their message.
 TEST(OpenCLContext, FailedCallsAreDescribed) {
   auto context = OpenCLContext::Create();
-  const cl_ulong max_alloc = context->Device().getInfo<CL_DEVICE_MAX_MEM_ALLOC_SIZE>();
+  // A buffer of 0 bytes: every driver must refuse it with CL_INVALID_BUFFER_SIZE (one beyond
+  // the largest allocation is not refused by every GPU driver, and would take its memory).
   try {
-    cl::Buffer too_large(context->Context(), CL_MEM_READ_WRITE, max_alloc + 4096);
-    ADD_FAILURE() << "a buffer beyond CL_DEVICE_MAX_MEM_ALLOC_SIZE was created";
+    cl::Buffer empty(context->Context(), CL_MEM_READ_WRITE, 0);
+    ADD_FAILURE() << "a buffer of 0 bytes was created";
   } catch (const cl::Error& e) {
     const std::string message = DescribeException(e);
     EXPECT_NE(message.find("OpenCL call clCreateBuffer failed: CL_INVALID_BUFFER_SIZE (-61)"),
               std::string::npos)
         << message;
     EXPECT_NE(message.find("--OrientationStereo.max_image_size"), std::string::npos) << message;
+    EXPECT_NE(message.find("--OrientationStereo.slice_block"), std::string::npos) << message;
   }
+  // Every code an OpenCL 1.2 call can return is named (-20 to -29 are no codes).
+  for (int code = -68; code <= 0; ++code) {
+    if (code <= -20 && code >= -29) continue;
+    EXPECT_EQ(OpenCLErrorString(code).find("unknown"), std::string::npos) << code;
+  }
+  EXPECT_EQ(OpenCLErrorString(CL_MAP_FAILURE), "CL_MAP_FAILURE (-12)");
   EXPECT_EQ(DescribeException(Error("plain")), "plain");
 }
 
