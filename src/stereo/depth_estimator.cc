@@ -624,6 +624,13 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     }
     if (progress != nullptr) progress->Stage("cost volume and aggregation (fine band)");
     std::vector<float> fine_volume = build_volume(0, 0, band, base, step);
+    // The cost volumes' and the coarser levels' filters' device buffers are done with: freed
+    // before the prior and the MRF allocate theirs, so that the device's peak is the larger of
+    // the two, not their sum (level 0's filter stays for the final depth filter).
+    for (size_t l = 0; l < levels.size(); ++l) {
+      levels[l].costs.clear();
+      if (l > 0) levels[l].filter.reset();
+    }
     if (use_prior) {
       ScopedStageTimer timer(timings, "geometric prior");
       prior_cl->Add(ref.camera.Scaled(width0, height0), 1.0, labels, base[0], step, band,
