@@ -140,8 +140,12 @@ TEST(SourceViews, TriangulationAngleTestsAndConfig) {
   EXPECT_EQ(s[1].sources, (std::vector<std::string>{"a.png", "near.png"}));
   EXPECT_EQ(s[2].reference, "near.png");
   EXPECT_EQ(s[2].sources, (std::vector<std::string>{"far.png"}));  // a.png fails the angle test
+  // Without the cfg: the automatic selection of every view, as before the cfg was written.
   options.use_config = false;
-  EXPECT_EQ(SelectSourceViews(ws, options).size(), 3u);
+  const std::vector<SourceViewSelection> automatic = SelectSourceViews(ws, options);
+  ASSERT_EQ(automatic.size(), 3u);
+  EXPECT_EQ(automatic[0].reference, "a.png");
+  EXPECT_EQ(automatic[0].sources, (std::vector<std::string>{"far.png"}));
   options.use_config = true;
   options.config_path = JoinPaths(dir, "missing.cfg");
   EXPECT_NE(ErrorOf([&] { SelectSourceViews(ws, options); }).find("missing.cfg"),

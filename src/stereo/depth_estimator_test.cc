@@ -37,16 +37,34 @@ TEST(DepthEstimator, SubpixelOffsetsFollowEquation9) {
   EXPECT_FLOAT_EQ(offsets[2], 0.0f);
 }
 
+// lambda exp(-|O(p) - O(p')|^2 / (2 sigma_o^2)) per edge: differences in both channels, of a
+// size whose square is neither 1 nor the size itself; 0 beyond the last column and row.
 TEST(DepthEstimator, SmoothnessWeightsFollowEquation3) {
   FloatMap o(2, 2, 2);
-  o.At(0, 0, 0) = 1.0f;
-  o.At(0, 1, 0) = 1.0f;
-  o.At(1, 0, 0) = 0.0f;
+  o.At(0, 0, 0) = 0.5f;
+  o.At(0, 0, 1) = 0.1f;
+  o.At(0, 1, 0) = 0.5f;  // the same as (0, 0)
+  o.At(0, 1, 1) = 0.1f;
+  o.At(1, 0, 0) = 0.2f;  // (0, 0) less (0.3, 0.4): |dO|^2 = 0.25
+  o.At(1, 0, 1) = -0.3f;
+  o.At(1, 1, 0) = 0.5f;  // (0, 1) less (0, 0.1): |dO|^2 = 0.01
+  o.At(1, 1, 1) = 0.0f;
+  const double sigma = 0.15;
+  const auto weight = [&](double squared_difference) {
+    return 2.0 * std::exp(-squared_difference / (2 * sigma * sigma));
+  };
   std::vector<float> right, down;
-  SmoothnessWeights(o, 2.0, 0.15, &right, &down);
+  SmoothnessWeights(o, 2.0, sigma, &right, &down);
+  ASSERT_EQ(right.size(), 4u);
+  ASSERT_EQ(down.size(), 4u);
   EXPECT_FLOAT_EQ(right[0], 2.0f);
-  EXPECT_NEAR(down[0], 2.0 * std::exp(-1.0 / (2 * 0.15 * 0.15)), 1e-7);
+  EXPECT_NEAR(down[0], weight(0.25), 1e-6);
+  EXPECT_NEAR(down[1], weight(0.01), 1e-6);
+  EXPECT_NEAR(right[2], weight(0.18), 1e-6);  // (1, 0) to (1, 1): (0.3, 0.3)
   EXPECT_FLOAT_EQ(right[1], 0.0f);  // last column
+  EXPECT_FLOAT_EQ(right[3], 0.0f);
+  EXPECT_FLOAT_EQ(down[2], 0.0f);  // last row
+  EXPECT_FLOAT_EQ(down[3], 0.0f);
 }
 
 struct Result {

@@ -293,7 +293,9 @@ TEST(OrientationStereoWorkspace, MaskPathOutsideTheWorkspace) {
   EXPECT_GT(kept, 48 * 72 / 2);
   EXPECT_EQ(outside, 0);
   const OrientationFieldOptions fields;
-  for (const ViewOutputs& view : WorkspaceOutputs(path, options, fields)) {
+  const std::vector<ViewOutputs> outputs = WorkspaceOutputs(path, options, fields);
+  ASSERT_EQ(outputs.size(), 4u);
+  for (const ViewOutputs& view : outputs) {
     EXPECT_EQ(view.fields, ViewOutputs::Fields::kUpToDate) << view.name << ": " << view.why_stale;
   }
   // Without the masks, the cached fields (computed with them) are stale.

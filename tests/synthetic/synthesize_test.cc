@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 
 #include "colmap_ext/workspace.h"
@@ -92,6 +93,7 @@ TEST(Synthesize, GantryWorkspaceReadsBackWithGroundTruth) {
   const Reconstruction& model = ws.Model();
   ASSERT_GT(model.points3D.size(), 50u);
   const std::string gt_path = JoinPaths(path, "gt");
+  std::map<std::string, FloatMap> true_depths;  // per image name, read once
   for (const auto& [id, point] : model.points3D) {
     ASSERT_GE(point.track.size(), 2u);
     for (const TrackElement& el : point.track) {
@@ -100,7 +102,18 @@ TEST(Synthesize, GantryWorkspaceReadsBackWithGroundTruth) {
       EXPECT_EQ(p2d.point3D_id, id);
       const Eigen::Vector3d xc = image.R() * point.xyz + image.t();
       const Eigen::Vector3d uv = camera.CalibrationMatrix() * xc;
-      EXPECT_LT((uv.head<2>() / uv.z() - p2d.xy).norm(), 0.51);
+      // Exact projections (pixel centres at +0.5), up to the float depth a point was made from.
+      EXPECT_LT((uv.head<2>() / uv.z() - p2d.xy).norm(), 1e-3);
+      // The true depth of the pixel seen there: the point's own, within 2 px's footprint.
+      auto truth = true_depths.find(image.name);
+      if (truth == true_depths.end()) {
+        truth = true_depths.emplace(image.name, ReadGroundTruthView(gt_path, image.name).depth)
+                    .first;
+      }
+      const float depth = truth->second.At(static_cast<int>(p2d.xy.y()),
+                                           static_cast<int>(p2d.xy.x()));
+      EXPECT_NEAR(depth, xc.z(), 2.0 * xc.z() / camera.CalibrationMatrix()(0, 0) + 1e-6)
+          << image.name << " at " << p2d.xy.transpose();
     }
   }
 
