@@ -231,6 +231,18 @@ TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {
       VisualHullDepthRange(scene.ref, ref_mask, scene.others, 0.3, 5.0, &min_b, &max_b));
   EXPECT_DOUBLE_EQ(min_a, min_b);
   EXPECT_DOUBLE_EQ(max_a, max_b);
+  // A view with the sphere in front of it but outside its frame (45 degrees off its axis, its
+  // half field of view 22 degrees), with an empty mask: the points project beside the frame,
+  // not onto its border pixels.
+  const StereoCamera beside =
+      LookAtCamera(Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 1), 200, 160, 120);
+  const Eigen::Vector3d centre_in_beside = beside.R * kCentre + beside.t;
+  ASSERT_GT(centre_in_beside.z(), 0);
+  scene.others.emplace_back(beside, FloatMap(160, 120, 1, 0.0f));
+  ASSERT_TRUE(
+      VisualHullDepthRange(scene.ref, ref_mask, scene.others, 0.3, 5.0, &min_b, &max_b));
+  EXPECT_DOUBLE_EQ(min_a, min_b);
+  EXPECT_DOUBLE_EQ(max_a, max_b);
 }
 
 TEST(DepthRangeTest, NoRangeWhenTheViewsSeeingTheRaysExcludeEverything) {
