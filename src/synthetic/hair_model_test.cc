@@ -152,13 +152,28 @@ TEST(DensifyStrands, KeepsStoredPointsFollowsSplineAndTapers) {
       EXPECT_LT((dense.points[k + 1] - dense.points[k]).norm(), 2.0 * spacing);
     }
   }
-  // The dense points lie on the uniform Catmull-Rom spline of the evaluation code: its
-  // midpoints of the first segment of strand 0 match.
-  const Eigen::Vector3d p0 = hair.points[0].cast<double>(), p1 = hair.points[1].cast<double>(),
-                        p2 = hair.points[2].cast<double>();
-  const Eigen::Vector3d on_spline = CatmullRom(p0, p0, p1, p2, 0.5);
-  const double d = DistanceToPolyline(dense.points, dense.offsets[0], dense.offsets[1], on_spline);
-  EXPECT_LT(d, 2e-5);
+  // The dense points lie on the uniform Catmull-Rom spline of the evaluation code (its ends'
+  // neighbours repeated): every segment's midpoint on the spline lies on the dense polyline,
+  // while the chord's midpoint, which linear densification would give, is often off it.
+  int segments = 0, chord_off = 0;
+  double worst = 0;
+  for (int s = 0; s < hair.NumStrands(); s += 17) {
+    const int64_t first = hair.offsets[s], last = hair.offsets[s + 1] - 1;
+    auto point = [&](int64_t i) {
+      return hair.points[std::clamp(i, first, last)].cast<double>();
+    };
+    for (int64_t i = first; i < last; ++i) {
+      const Eigen::Vector3d on_spline =
+          CatmullRom(point(i - 1), point(i), point(i + 1), point(i + 2), 0.5);
+      worst = std::max(worst, DistanceToPolyline(dense.points, dense.offsets[s],
+                                                 dense.offsets[s + 1], on_spline));
+      chord_off += (0.5 * (point(i) + point(i + 1)) - on_spline).norm() > 1e-4;
+      ++segments;
+    }
+  }
+  ASSERT_GT(segments, 100);
+  EXPECT_LT(worst, 2e-5);
+  EXPECT_GT(chord_off, segments / 4);
   // A spacing that would take more points than memory holds is refused before any is made.
   const std::string error =
       testing_util::ErrorOf([&] { DensifyStrands(hair, 1e-12, 1e-4, 1e-4); });
