@@ -527,6 +527,36 @@ TEST(OrientationStereoWorkspace, WithoutThePriorGeometricMapsKeepConsistentPhoto
   options.geom_consistency_only = true;
   EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, options, &timings).num_views, 1);
   EXPECT_EQ(ReadMat(workspace.DepthMapPath("v0.png", "geometric")).Data(), geometric.Data());
+  // A patch of v0's estimate 30% too far disagrees with every other view's map: dropped, the
+  // rest kept as before.
+  FloatMap wrong = photometric;
+  size_t patch = 0;
+  const auto in_patch = [&](int row, int col) {
+    return row >= wrong.Height() / 3 && row < wrong.Height() / 2 && col >= wrong.Width() / 3 &&
+           col < wrong.Width() / 2;
+  };
+  for (int row = 0; row < wrong.Height(); ++row) {
+    for (int col = 0; col < wrong.Width(); ++col) {
+      if (in_patch(row, col) && wrong.At(row, col) > 0) {
+        wrong.At(row, col) *= 1.3f;
+        ++patch;
+      }
+    }
+  }
+  ASSERT_GT(patch, 20u);
+  WriteMat(workspace.DepthMapPath("v0.png", "photometric"), wrong);
+  EXPECT_EQ(RunOrientationStereo(path, {"v0.png"}, options, &timings).num_views, 1);
+  const FloatMap filtered = ReadMat(workspace.DepthMapPath("v0.png", "geometric"));
+  for (int row = 0; row < wrong.Height(); ++row) {
+    for (int col = 0; col < wrong.Width(); ++col) {
+      if (in_patch(row, col)) {
+        EXPECT_EQ(filtered.At(row, col), 0.0f) << row << ", " << col;
+      } else {
+        EXPECT_EQ(filtered.At(row, col), geometric.At(row, col)) << row << ", " << col;
+      }
+    }
+  }
+  WriteMat(workspace.DepthMapPath("v0.png", "photometric"), photometric);
   // ... and says which view has no .photometric map to filter.
   std::filesystem::remove(workspace.DepthMapPath("v1.png", "photometric"));
   try {
