@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "colmap_ext/reconstruction.h"
+#include "colmap_ext/source_views.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/depth_geometry.h"
 #include "src/core/enum_names.h"
@@ -262,18 +263,18 @@ SynthesizeResult RunSynthesize(const SynthesizeOptions& options) {
   WriteReconstruction(model, JoinPaths(staging.Path(), "sparse"), ModelFormat::kText);
 
   // stereo/*.cfg as colmap image_undistorter writes them.
-  WriteFileAtomically(
-      JoinPaths(dense_path, "stereo", "patch-match.cfg"),
-      [&](std::ostream& out) {
-        for (const auto& v : views) out << v.name << "\n__auto__, 20\n";
-      },
-      false);
-  WriteFileAtomically(
-      JoinPaths(dense_path, "stereo", "fusion.cfg"),
-      [&](std::ostream& out) {
-        for (const auto& v : views) out << v.name << "\n";
-      },
-      false);
+  std::vector<PatchMatchProblem> problems;
+  std::vector<std::string> view_names;
+  for (const auto& v : views) {
+    PatchMatchProblem problem;
+    problem.reference = v.name;
+    problem.kind = PatchMatchProblem::Kind::kAuto;
+    problem.num_auto = 20;
+    problems.push_back(problem);
+    view_names.push_back(v.name);
+  }
+  WritePatchMatchConfig(JoinPaths(dense_path, "stereo", "patch-match.cfg"), problems);
+  WriteFusionConfig(JoinPaths(dense_path, "stereo", "fusion.cfg"), view_names);
 
   // gt/: cameras, strands, settings.
   GroundTruthCameras cameras;
