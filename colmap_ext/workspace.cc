@@ -108,9 +108,12 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
     } else if (masks_of == MasksOf::kImages && PngSize(mask, &width, &height)) {
       const Camera& camera = ws.model_.cameras.at(ws.ImageByName(name).camera_id);
       const double scale = static_cast<double>(width) / camera.width;
+      // Only those read as scaled copies: one of another aspect ratio is refused when read.
       if ((width != static_cast<int>(camera.width) ||
            height != static_cast<int>(camera.height)) &&
-          scale > 0.9 && scale < 1.1) {
+          scale > 0.9 && scale < 1.1 &&
+          IsScaledCopy(width, height, static_cast<int>(camera.width),
+                       static_cast<int>(camera.height))) {
         std::ostringstream line;
         line << name << " (" << width << " x " << height << " for " << camera.width << " x "
              << camera.height << ")";

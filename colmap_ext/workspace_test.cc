@@ -90,7 +90,8 @@ TEST(Workspace, ReadsLayoutAndPaths) {
 }
 
 // A mask a few percent off its image's size (drawn on the photo before the undistorter) is
-// warned about; one of the same size or a scaled copy (twice the size) is not.
+// warned about; one of the same size or a scaled copy (twice the size) is not, nor one of
+// another aspect ratio (refused when read).
 TEST(Workspace, MasksAFewPercentOffTheImageSizeAreWarnedAbout) {
   const std::string dir = MakeTestDir("ws_mask_sizes");
   WriteTestWorkspace(dir, MakePlaneModel());  // 64 x 48 images
@@ -109,6 +110,16 @@ TEST(Workspace, MasksAFewPercentOffTheImageSizeAreWarnedAbout) {
   EXPECT_NE(log.find("1 mask(s) a few percent off their image's size, c.png (66 x 49 for 64 x 48)"),
             std::string::npos)
       << log;
+  // One of another aspect ratio is no scaled copy: refused when read, not said to be read as
+  // one.
+  cv::imwrite(JoinPaths(dir, "masks", "c.png.png"), cv::Mat(48, 60, CV_8U, cv::Scalar(255)));
+  ::testing::internal::CaptureStderr();
+  const Workspace ws = Workspace::Read(dir);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("a few percent off"), std::string::npos) << log;
+  EXPECT_NE(ErrorOf([&] { ReadMask(ws.MaskPath("c.png"), 64, 48); })
+                .find("is 60 x 48, another aspect ratio"),
+            std::string::npos);
 }
 
 TEST(Workspace, BadWorkspaces) {
