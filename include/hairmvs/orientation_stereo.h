@@ -113,6 +113,9 @@ struct OrientationStereoOptions {
   // g0_c, g2_c, g4_c, g5_r per-pixel median 6.12 -> 5.87 mm; a synthesised curly T group
   // (100k strands, 960 px) 3.41 -> 2.94 mm. 256 (lambda 0.03125, truncation 16 labels: the
   // same per metre): the g2 group 4.04 against 4.02 mm (measured on a1ce4c7).
+  // The MRF kernels keep about 20 bytes per label per work-item in private memory (a few
+  // arrays of NUM_LABELS floats): 2.5 KB at 128 labels, 80 KB at the bound of 4096, which a GPU
+  // spills to its global memory for every resident work-item (untested on a GPU: none here).
   int num_depths = 128;
   // Orientation pyramid levels used by the data term (paper: 3), finest first. The pyramid
   // itself reaches coarse_level too (PyramidLevels), whose grid the coarse stage solves on
