@@ -155,6 +155,10 @@ struct DepthMetrics {
   long num_hair_pixels = 0;
   long num_with_depth = 0;       // hair pixels with a depth > 0
   double completeness = 0;       // num_with_depth / num_hair_pixels
+  // Depths > 0 where the truth is background (beyond the hair's silhouette), and their share of
+  // the depths on hair or background.
+  long num_background_depths = 0;
+  double background_depth_fraction = 0;
   // |depth - true depth| on hair pixels with a depth.
   double mean_abs_error_mm = 0;
   double median_abs_error_mm = 0;
@@ -179,7 +183,8 @@ struct DepthMetrics {
   // (DepthEvaluationOptions::smooth_error_window_px); 0 when not computed.
   double smooth_median_abs_error_mm = 0;
   double rough_median_abs_error_mm = 0;
-  // 3D: back-projected with the workspace's camera, distance to the nearest true strand.
+  // 3D: every depth on a true hair or background pixel (not on skin), back-projected with the
+  // workspace's camera, distance to the nearest true strand.
   long num_points_3d = 0;
   double accuracy_3d_mean_mm = 0;
   double accuracy_3d_median_mm = 0;

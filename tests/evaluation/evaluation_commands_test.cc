@@ -317,6 +317,49 @@ TEST(EvaluationCommands, Overall3DFiguresWeighEachViewByItsPixels) {
   EXPECT_LT(result.overall.accuracy_3d_median_mm, 0.06);
 }
 
+// Depths beyond the hair's silhouette (where the truth is background) are errors of the map
+// that no true depth measures per pixel: they count in the 3D figures (distance to the nearest
+// strand) and in their own share, and leave the per-pixel figures as they were.
+TEST(EvaluationCommands, DepthsOnTheBackgroundCountIn3D) {
+  ImportedView imported = ImportView("background", "v0.png");
+  DepthEvaluationOptions options = FastDepthOptions();
+  options.image_names = {"v0.png"};
+  options.max_points_3d_per_view = 0;  // every point
+  const DepthEvaluationResult exact = EvaluateDepthMaps(imported.workspace, imported.scene.gt,
+                                                        options);
+  EXPECT_EQ(exact.overall.num_background_depths, 0);
+  EXPECT_LT(exact.overall.accuracy_3d_mean_mm, 0.06);
+  // Every background pixel gets a depth 20 mm in front of the plane the hair lies in: at least
+  // 20 mm from every strand.
+  FloatMap depth = ReadMat(imported.depth_map_path);
+  long spilled = 0, hair = 0;
+  for (int r = 0; r < kHeight; ++r) {
+    for (int c = 0; c < kWidth; ++c) {
+      if (imported.truth.label[r * kWidth + c] == kLabelBackground) {
+        depth.At(r, c) = static_cast<float>(kPlaneZ - 0.02);
+        ++spilled;
+      } else {
+        hair += depth.At(r, c) > 0;
+      }
+    }
+  }
+  ASSERT_GT(spilled, 100);
+  WriteMat(imported.depth_map_path, depth);
+  const DepthEvaluationResult result =
+      EvaluateDepthMaps(imported.workspace, imported.scene.gt, options);
+  const DepthMetrics& m = result.overall;
+  EXPECT_EQ(m.num_background_depths, spilled);
+  EXPECT_NEAR(m.background_depth_fraction, static_cast<double>(spilled) / (spilled + hair), 1e-12);
+  EXPECT_EQ(m.num_points_3d, spilled + hair);
+  // The mean over all points: the spilled share at >= 20 mm (up to the plane's 5 mm margin of
+  // strands beyond the hair, at 20 mm in front still >= 20 mm).
+  EXPECT_GT(m.accuracy_3d_mean_mm, 19.9 * spilled / (spilled + hair));
+  EXPECT_EQ(m.num_with_depth, exact.overall.num_with_depth);
+  EXPECT_DOUBLE_EQ(m.median_abs_error_mm, exact.overall.median_abs_error_mm);
+  EXPECT_DOUBLE_EQ(m.completeness, exact.overall.completeness);
+  EXPECT_NE(result.Table().find("    bg "), std::string::npos) << result.Table();
+}
+
 TEST(EvaluationCommands, SignedErrorsNearTheSilhouetteAndInside) {
   // v0's depths 3 mm behind the truth within 4 px of the background, 1 mm in front further in;
   // the distance to the nearest background pixel by brute force.
