@@ -307,7 +307,7 @@ struct MeshEvaluationResult {
   long num_vertices = 0;
   long num_faces = 0;
   DistanceStats accuracy_vertices;  // mesh vertices to the nearest true strand
-  DistanceStats accuracy_surface;   // vertices and face samples to the nearest true strand
+  DistanceStats accuracy_surface;   // points uniform over the faces (by area) to the nearest strand
   DistanceStats completeness_distance;  // true visible hair surface to the mesh
   double completeness_2mm = 0;  // fraction of the true visible hair surface within 2 mm
   double completeness_5mm = 0;
