@@ -230,10 +230,11 @@ bool OptionParser::Parse(int argc, char** argv, int first) {
         }
         // Other commands' sections are passed over.
       }
-      THROW_IF(!unknown_own.empty(),
-               "--project_path " << path << ": unknown option" << (unknown_own.size() > 1 ? "s" : "")
-                                 << " " << JoinStrings(unknown_own, ", ") << " (see hairmvs "
-                                 << impl_->command << " -h)");
+      THROW_IF(!unknown_own.empty(), "--project_path "
+                                         << path << ": unknown option"
+                                         << (unknown_own.size() > 1 ? "s " : " ")
+                                         << JoinStrings(unknown_own, ", ") << " (see hairmvs "
+                                         << impl_->command << " -h)");
       po::store(from_file, impl_->vm);
       LOG(INFO) << path << ": options read from it: "
                 << (used.empty() ? "none" : JoinStrings(used, ", "));
