@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <utility>
 
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
@@ -10,6 +9,7 @@
 #include "src/core/logging.h"
 
 namespace hairmvs {
+
 void SmoothDetailOffsets(const FusionMesh& mesh, double weight, std::vector<double>* offsets) {
   const int n = static_cast<int>(offsets->size());
   std::vector<Eigen::Triplet<double>> entries;
@@ -19,17 +19,7 @@ void SmoothDetailOffsets(const FusionMesh& mesh, double weight, std::vector<doub
     entries.emplace_back(i, i, 1.0);
     rhs[i] = (*offsets)[i];
   }
-  // Each edge once, however many faces share it.
-  std::vector<std::pair<int, int>> edges;
-  for (const Eigen::Vector3i& face : mesh.faces) {
-    for (int k = 0; k < 3; ++k) {
-      edges.emplace_back(std::minmax(face[k], face[(k + 1) % 3]));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-  std::vector<bool> reached(n, false);  // whether the vertex's part of the mesh has a target
-  for (const auto& [a, b] : edges) {
+  for (const auto& [a, b] : mesh.Edges()) {
     entries.emplace_back(a, a, weight);
     entries.emplace_back(b, b, weight);
     entries.emplace_back(a, b, -weight);
@@ -46,28 +36,20 @@ void SmoothDetailOffsets(const FusionMesh& mesh, double weight, std::vector<doub
     return;
   }
   const Eigen::VectorXd solved = solver.solve(rhs);
-  // The parts reached from a vertex with a target, by the edges.
-  std::vector<std::vector<int>> neighbours(n);
-  for (const auto& [a, b] : edges) {
-    neighbours[a].push_back(b);
-    neighbours[b].push_back(a);
-  }
-  std::vector<int> stack;
-  for (int i = 0; i < n; ++i) {
-    if (!std::isnan((*offsets)[i]) && !reached[i]) {
-      reached[i] = true;
-      stack.push_back(i);
+  // The parts of the mesh (FaceComponents) that hold a vertex with a target.
+  int num_components = 0;
+  const std::vector<int> component = mesh.FaceComponents(&num_components);
+  std::vector<bool> has_target(num_components, false);
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      if (!std::isnan((*offsets)[mesh.faces[f][k]])) has_target[component[f]] = true;
     }
   }
-  while (!stack.empty()) {
-    const int i = stack.back();
-    stack.pop_back();
-    for (int j : neighbours[i]) {
-      if (!reached[j]) {
-        reached[j] = true;
-        stack.push_back(j);
-      }
-    }
+  std::vector<bool> reached(n, false);
+  for (int i = 0; i < n; ++i) reached[i] = !std::isnan((*offsets)[i]);
+  for (size_t f = 0; f < mesh.faces.size(); ++f) {
+    if (!has_target[component[f]]) continue;
+    for (int k = 0; k < 3; ++k) reached[mesh.faces[f][k]] = true;
   }
   for (int i = 0; i < n; ++i) (*offsets)[i] = reached[i] ? solved[i] : std::nan("");
 }

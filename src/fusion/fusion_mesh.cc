@@ -1,17 +1,12 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <numeric>
-#include <unordered_set>
+#include <utility>
 
 #include "src/fusion/fusion_view.h"
 
 namespace hairmvs {
 namespace {
-
-uint64_t EdgeKey(int a, int b) {
-  if (a > b) std::swap(a, b);
-  return (static_cast<uint64_t>(a) << 32) | static_cast<uint32_t>(b);
-}
 
 int FindRoot(std::vector<int>* parent, int i) {
   while ((*parent)[i] != i) {
@@ -49,14 +44,18 @@ double FusionMesh::MeanEdgeLength() const {
   return count > 0 ? sum / count : 0.0;
 }
 
-int FusionMesh::NumEdges() const {
-  std::unordered_set<uint64_t> edges;
-  edges.reserve(faces.size() * 2);
+std::vector<std::pair<int, int>> FusionMesh::Edges() const {
+  std::vector<std::pair<int, int>> edges;
+  edges.reserve(faces.size() * 3);
   for (const Eigen::Vector3i& f : faces) {
-    for (int k = 0; k < 3; ++k) edges.insert(EdgeKey(f[k], f[(k + 1) % 3]));
+    for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(f[k], f[(k + 1) % 3]));
   }
-  return static_cast<int>(edges.size());
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
 }
+
+int FusionMesh::NumEdges() const { return static_cast<int>(Edges().size()); }
 
 int FusionMesh::EulerCharacteristic() const {
   return static_cast<int>(vertices.size()) - NumEdges() + static_cast<int>(faces.size());

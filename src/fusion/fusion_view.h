@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "src/core/depth_geometry.h"
@@ -63,6 +64,8 @@ struct FusionMesh {
 
   void ComputeVertexNormals();
   double MeanEdgeLength() const;
+  // Each edge once, however many faces share it, as (lower index, higher index), ascending.
+  std::vector<std::pair<int, int>> Edges() const;
   int NumEdges() const;
   int EulerCharacteristic() const;  // V - E + F
   // Face indices per connected component (faces sharing a vertex are connected).
