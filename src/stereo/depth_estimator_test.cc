@@ -249,6 +249,41 @@ TEST(DepthEstimator, CoarseStageWithoutTheFinestLevelStillRecoversThePlane) {
   EXPECT_NE(result.median_abs_error_m, all_levels.median_abs_error_m);  // level 0 was left out
 }
 
+// The coarse stage's data term is the sum of the levels from coarse_first_level on, each
+// scaled so that the levels used count for the paper's three: with one weight per level
+// (level0_weight_angle_deg 0), levels 1 and 2 give 1.5 (L1 + L2), level 2 alone 3 L2 and level 1
+// alone (num_levels 2) 3 L1, so the first is the mean of the other two. Dropping the coarsest
+// level rather than the finest, or scaling by the count of all levels, breaks that.
+TEST(DepthEstimator, CoarseDataTermSumsTheLevelsFromCoarseFirstLevelOn) {
+  OrientationStereoOptions options = TestOptions();
+  options.coarse_level = 2;  // a 24 x 18 grid, so that coarse_first_level may be 2
+  options.level0_weight_angle_deg = 0;
+  options.write_cost_volume = true;
+  const auto coarse_term = [&](int num_levels, int first_level) {
+    OrientationStereoOptions o = options;
+    o.num_levels = num_levels;
+    o.coarse_first_level = first_level;
+    return ReconstructTiltedPlane(o).coarse_data_term;
+  };
+  const FloatMap all = coarse_term(3, 0), levels12 = coarse_term(3, 1),
+                 level2 = coarse_term(3, 2), level1 = coarse_term(2, 1);
+  ASSERT_EQ(levels12.Width(), 24);
+  ASSERT_EQ(levels12.Height(), 18);
+  ASSERT_EQ(levels12.Channels(), options.num_depths);
+  double largest = 0, largest_difference = 0, largest_from_all = 0;
+  for (size_t i = 0; i < levels12.Data().size(); ++i) {
+    const double expected = 0.5 * (level1.Data()[i] + level2.Data()[i]);
+    largest = std::max(largest, std::abs(expected));
+    largest_difference =
+        std::max(largest_difference, std::abs(levels12.Data()[i] - expected));
+    largest_from_all =
+        std::max(largest_from_all, std::abs(static_cast<double>(all.Data()[i]) - expected));
+  }
+  EXPECT_GT(largest, 0.0);
+  EXPECT_LE(largest_difference, 1e-5 * largest);
+  EXPECT_GT(largest_from_all, 0.05 * largest);  // level 0 counts when coarse_first_level is 0
+}
+
 // A data term of level 0 alone (num_levels 1) is still solved coarse to fine, on the grid of
 // coarse_level, which the pyramid reaches whatever num_levels: the coarse data term has the
 // grid's size, the fine stage runs, and the plane is found.
