@@ -1011,6 +1011,16 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     filter_progress.Finish();
   }
+  // colmap stereo_fusion reads stereo/fusion.cfg and aborts without one. A workspace from
+  // colmap image_undistorter has it; one made otherwise gets what the undistorter writes:
+  // every image of the model (fusion skips those without maps). Every job of an array writes
+  // the same, atomically; the user's own is never replaced.
+  const std::string fusion_cfg = JoinPaths(workspace.StereoPath(), "fusion.cfg");
+  if (result.num_views > 0 && !Exists(fusion_cfg)) {
+    WriteFusionConfig(fusion_cfg, workspace.ImageNames());
+    LOG(INFO) << "Wrote " << fusion_cfg << " (every image, as colmap image_undistorter does), "
+              << "which colmap stereo_fusion reads";
+  }
   // A map left empty is written as such (COLMAP's filter writes them too), but never silently:
   // an option that removes everything would otherwise look like a finished run.
   if (!empty_maps.empty()) {

@@ -14,6 +14,7 @@
 
 #include "colmap_ext/mat_io.h"
 #include "colmap_ext/reconstruction.h"
+#include "colmap_ext/source_views.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/logging.h"
 #include "hairmvs/orientation_fields.h"
@@ -146,6 +147,11 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
       << log;
   EXPECT_EQ(result.num_views, 1);
   const Workspace workspace = Workspace::Read(path);
+  // No stereo/fusion.cfg was there, which colmap stereo_fusion needs: one was written, with
+  // every image (as colmap image_undistorter writes it), whatever --image_names.
+  const std::string fusion_cfg = JoinPaths(path, "stereo", "fusion.cfg");
+  EXPECT_EQ(ReadFusionConfig(fusion_cfg, workspace.Model()), workspace.ImageNames());
+  EXPECT_NE(log.find("Wrote " + fusion_cfg), std::string::npos) << log;
   ASSERT_TRUE(ExistsFile(workspace.DepthMapPath("v0.png")));
   EXPECT_TRUE(ExistsFile(workspace.NormalMapPath("v0.png")));
   EXPECT_TRUE(ExistsFile(workspace.ConfidenceMapPath("v0.png")));
@@ -201,7 +207,9 @@ TEST(OrientationStereoWorkspace, ImageNamesWritesOnlyItsViewsAndRecoversThePlane
   EXPECT_TRUE(ExistsFile(picture));
   options.write_png = false;
   options.write_cost_volume = false;
+  WriteFusionConfig(fusion_cfg, {"v2.png"});  // the user's own: kept
   RunOrientationStereo(path, {"v0.png"}, options, nullptr);
+  EXPECT_EQ(ReadTextFile(fusion_cfg), "v2.png\n");
   EXPECT_FALSE(ExistsFile(picture));
   EXPECT_FALSE(ExistsFile(normal_picture));
   std::filesystem::remove_all(path);
