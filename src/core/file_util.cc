@@ -76,6 +76,16 @@ void RequireWritableDir(const std::string& path, const std::string& what) {
 
 std::string ParentPath(const std::string& path) { return fs::path(path).parent_path().string(); }
 
+bool IsSameOrInside(const std::string& inner, const std::string& outer) {
+  const fs::path a = fs::weakly_canonical(inner);
+  const fs::path b = fs::weakly_canonical(outer);
+  auto ia = a.begin();
+  for (auto ib = b.begin(); ib != b.end(); ++ib, ++ia) {
+    if (ia == a.end() || *ia != *ib) return false;
+  }
+  return true;
+}
+
 std::string ReadTextFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   THROW_IF(!in, "Cannot open " << path);

@@ -30,6 +30,9 @@ void CreateDirs(const std::string& path);
 // process may write there: checked before long work whose outputs go there.
 void RequireWritableDir(const std::string& path, const std::string& what = "folder");
 std::string ParentPath(const std::string& path);
+// Whether `inner` is `outer` or lies inside it, after resolving links, `.` and `..` (of the
+// parts that exist): an output that would land in an input.
+bool IsSameOrInside(const std::string& inner, const std::string& outer);
 std::string ReadTextFile(const std::string& path);
 std::vector<std::string> ReadLines(const std::string& path);
 std::string StripWhitespace(const std::string& s);

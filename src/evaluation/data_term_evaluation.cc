@@ -209,6 +209,8 @@ DataTermEvaluationResult EvaluateDataTerm(const std::string& workspace_path,
       ws, options.image_names, [&](const std::string& name) { return ws.CostVolumePath(name); },
       "No cost volumes in " + JoinPaths(ws.StereoPath(), "cost_volumes") +
           " (run orientation_stereo with --OrientationStereo.write_cost_volume 1)");
+  RequireOutputApartFromInputs(EvaluationFolder(ws, options.output_path), "--output_path",
+                               ground_truth_path);
   const GroundTruthCameras true_cameras =
       ReadTrueCameras(ground_truth_path, options.in_true_cameras);
 

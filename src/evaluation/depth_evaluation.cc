@@ -303,6 +303,7 @@ DepthEvaluationResult EvaluateWorkspaceDepthMaps(const Workspace& ws,
                                                  StageTimings* timings) {
   StageLaps laps(timings);
   const std::string output_path = EvaluationFolder(ws, options.output_path);
+  RequireOutputApartFromInputs(output_path, "--output_path", ground_truth_path);
 
   const GroundTruthCameras true_cameras =
       ReadTrueCameras(ground_truth_path, options.in_true_cameras);

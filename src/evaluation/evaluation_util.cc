@@ -146,6 +146,18 @@ std::string EvaluationFolder(const Workspace& ws, const std::string& output_path
   return output_path.empty() ? JoinPaths(ws.StereoPath(), "evaluation") : output_path;
 }
 
+void RequireOutputApartFromInputs(const std::string& output, const std::string& option,
+                                  const std::string& ground_truth_path,
+                                  const std::string& evaluated_file) {
+  if (output.empty()) return;
+  THROW_IF(!evaluated_file.empty() && IsSameOrInside(output, evaluated_file),
+           option << " " << output << " is the file evaluated, " << evaluated_file
+                  << ": give another path for the results");
+  THROW_IF(IsSameOrInside(output, ground_truth_path),
+           option << " " << output << " lies in the ground truth folder " << ground_truth_path
+                  << ": give a path outside it for the results");
+}
+
 void WriteJsonSummary(const std::string& path, const nlohmann::json& json) {
   const std::string text = json.dump(1);
   WriteFileAtomically(path, [&text](std::ostream& out) { out << text << "\n"; }, false);

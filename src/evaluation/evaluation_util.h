@@ -46,6 +46,12 @@ std::vector<std::string> ViewsToEvaluate(
     const std::function<std::string(const std::string&)>& path_of, const std::string& none_found);
 // An evaluator's output folder: `output_path`, or <workspace>/stereo/evaluation when empty.
 std::string EvaluationFolder(const Workspace& ws, const std::string& output_path);
+// Throws hairmvs::Error naming `option` unless `output` (a file or folder an evaluation
+// writes; empty = none) lies outside the ground truth folder and is not the file evaluated
+// (`evaluated_file`, empty = none): an evaluation never writes over its inputs.
+void RequireOutputApartFromInputs(const std::string& output, const std::string& option,
+                                  const std::string& ground_truth_path,
+                                  const std::string& evaluated_file = "");
 // Writes an evaluator's JSON summary atomically (indented, newline-terminated).
 void WriteJsonSummary(const std::string& path, const nlohmann::json& json);
 

@@ -27,16 +27,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-bool IsSameOrInside(const fs::path& inner, const fs::path& outer) {
-  const fs::path a = fs::weakly_canonical(inner);
-  const fs::path b = fs::weakly_canonical(outer);
-  auto ia = a.begin();
-  for (auto ib = b.begin(); ib != b.end(); ++ib, ++ia) {
-    if (ia == a.end() || *ia != *ib) return false;
-  }
-  return true;
-}
-
 // images/ or masks/ of the output: a symlink to the workspace's folder, or a copy.
 void LinkOrCopyFolder(const std::string& from, const std::string& to, bool copy) {
   if (!ExistsDir(from)) return;
@@ -135,9 +125,7 @@ ImportGroundTruthResult ImportGroundTruth(const std::string& ground_truth_path,
   THROW_IF(IsSameOrInside(output_path, workspace_path),
            "--output_path " << output_path << " is inside the workspace " << workspace_path
                             << ": import_ground_truth writes a new workspace");
-  THROW_IF(IsSameOrInside(output_path, ground_truth_path),
-           "--output_path " << output_path << " is inside the ground truth folder "
-                            << ground_truth_path);
+  RequireOutputApartFromInputs(output_path, "--output_path", ground_truth_path);
   THROW_IF(IsSameOrInside(workspace_path, output_path),
            "--output_path " << output_path << " contains the workspace " << workspace_path);
   const Workspace ws = Workspace::Read(workspace_path);

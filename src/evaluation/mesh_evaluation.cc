@@ -192,6 +192,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const std::string& workspace_path,
                                   const MeshEvaluationOptions& options,
                                   StageTimings* timings) {
+  RequireOutputApartFromInputs(options.output_json, "--output_json", ground_truth_path, mesh_path);
   // The mesh first: a missing or malformed one is named at once, not after the strands' index
   // (seconds to minutes) is built.
   const TriangleMesh mesh = ReadMeshToEvaluate(mesh_path, options, timings);
@@ -212,6 +213,7 @@ MeshEvaluationResult EvaluateMesh(const std::string& mesh_path,
                                   const MeshEvaluationOptions& options,
                                   const StrandDistance& strand_distance,
                                   StageTimings* timings) {
+  RequireOutputApartFromInputs(options.output_json, "--output_json", ground_truth_path, mesh_path);
   return EvaluateReadMesh(ReadMeshToEvaluate(mesh_path, options, timings), mesh_path,
                           ground_truth_path, workspace_path, options, strand_distance, timings);
 }

@@ -824,6 +824,46 @@ TEST(EvaluationCommands, ImportRefusesToWriteIntoItsInputs) {
 // The bytes of a file, to tell whether a failed run left it as it was.
 std::string FileBytes(const std::string& path) { return ReadTextFile(path); }
 
+TriangleMesh HairPlaneMesh(double offset_z) {
+  TriangleMesh mesh;
+  const float z = static_cast<float>(kPlaneZ + offset_z);
+  mesh.vertices = {{-0.03f, -0.02f, z}, {0.03f, -0.02f, z}, {0.03f, 0.02f, z}, {-0.03f, 0.02f, z}};
+  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
+  return mesh;
+}
+
+// Neither evaluation writes its results over the mesh evaluated or into the ground truth
+// (found writing the JSON over the mesh, and over gt/meta.json).
+TEST(EvaluationCommands, EvaluationsRefuseToWriteOverTheirInputs) {
+  const Scene scene = MakeScene("refuse_eval");
+  const std::string mesh = JoinPaths(scene.dir, "mesh.ply");
+  WriteMeshPly(mesh, HairPlaneMesh(0.0));
+  const std::string mesh_bytes = FileBytes(mesh);
+  MeshEvaluationOptions mesh_options;
+  mesh_options.output_json = mesh;
+  std::string error =
+      testing_util::ErrorOf([&] { EvaluateMesh(mesh, scene.gt, "", mesh_options); });
+  EXPECT_NE(error.find("--output_json " + mesh + " is the file evaluated"), std::string::npos)
+      << error;
+  EXPECT_EQ(FileBytes(mesh), mesh_bytes);
+  mesh_options.output_json = JoinPaths(scene.gt, "meta.json");
+  error = testing_util::ErrorOf([&] { EvaluateMesh(mesh, scene.gt, "", mesh_options); });
+  EXPECT_NE(error.find(" lies in the ground truth folder " + scene.gt), std::string::npos)
+      << error;
+  EXPECT_FALSE(ExistsFile(mesh_options.output_json));
+
+  const std::string out = JoinPaths(scene.dir, "imported");
+  ImportGroundTruth(scene.gt, scene.workspace, out, ImportGroundTruthOptions());
+  DepthEvaluationOptions depth_options = FastDepthOptions();
+  depth_options.output_path = JoinPaths(scene.gt, "evaluation");
+  error = testing_util::ErrorOf([&] { EvaluateDepthMaps(out, scene.gt, depth_options); });
+  EXPECT_NE(error.find("--output_path " + depth_options.output_path + " lies in the ground "
+                       "truth folder"),
+            std::string::npos)
+      << error;
+  EXPECT_FALSE(std::filesystem::exists(depth_options.output_path));
+}
+
 // `path` cut to half its size.
 void TruncateToHalf(const std::string& path) {
   std::filesystem::resize_file(path, std::filesystem::file_size(path) / 2);
@@ -881,14 +921,6 @@ TEST(EvaluationCommands, EvaluationStoppedByABadMapLeavesTheOldPictures) {
   for (const auto& entry : std::filesystem::directory_iterator(folder)) {
     EXPECT_NE(entry.path().filename().string()[0], '.') << entry.path();
   }
-}
-
-TriangleMesh HairPlaneMesh(double offset_z) {
-  TriangleMesh mesh;
-  const float z = static_cast<float>(kPlaneZ + offset_z);
-  mesh.vertices = {{-0.03f, -0.02f, z}, {0.03f, -0.02f, z}, {0.03f, 0.02f, z}, {-0.03f, 0.02f, z}};
-  mesh.faces = {{0, 1, 2}, {0, 2, 3}};
-  return mesh;
 }
 
 TEST(EvaluationCommands, EvaluateMesh) {
