@@ -42,6 +42,17 @@ bool PngSize(const std::string& path, int* width, int* height) {
   return true;
 }
 
+// A path inside images/ and stereo/'s folders that names one file one way: relative, no `.`,
+// `..` or empty parts. COLMAP takes image names as paths below images/ (sub-folders for a
+// rig's cameras), and every output of a view is named after it.
+bool IsPlainRelativePath(const std::string& name) {
+  if (name.empty() || name.front() == '/') return false;
+  for (const std::string& part : SplitString(name, "/")) {
+    if (part.empty() || part == "." || part == "..") return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
@@ -63,6 +74,13 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
   RequireDir(images, "images folder");
   for (uint32_t id : ws.model_.image_order) {
     const Image& image = ws.model_.images.at(id);
+    // Two names for one file would overwrite each other's maps; `..` would write outside the
+    // workspace.
+    THROW_IF(!IsPlainRelativePath(image.name),
+             sparse << ": image " << id << " is named '" << image.name
+                    << "', which is no path inside " << images
+                    << " (it must be relative, without '.', '..' or empty parts): the view's "
+                       "outputs are named after it");
     // Unique: ReadReconstruction checks it.
     ws.image_id_by_name_.emplace(image.name, id);
     ws.image_idx_by_name_.emplace(image.name, static_cast<int>(ws.image_idx_by_name_.size()));
@@ -90,7 +108,8 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
   if (!mask_path.empty()) {
     THROW_IF(!ExistsDir(mask_path), "Missing mask folder (the mask_path given): " << mask_path);
     ws.mask_path_ = mask_path;
-  } else if (ExistsDir(JoinPaths(path, "masks"))) {
+  } else if (Exists(JoinPaths(path, "masks"))) {  // a file there is no "no masks"
+    RequireDir(JoinPaths(path, "masks"), "mask folder");
     ws.mask_path_ = JoinPaths(path, "masks");
   }
   // Each image's mask looked up once: those without one, and those a few percent off their

@@ -176,6 +176,28 @@ TEST(Workspace, BadWorkspaces) {
   const std::string none = ErrorOf([&] { Workspace::Read(missing); });
   EXPECT_NE(none.find("None of the 3 images of the model"), std::string::npos) << none;
   EXPECT_NE(none.find(JoinPaths(missing, "images", "a.png")), std::string::npos) << none;
+  // A file where the masks folder belongs: an error, not a workspace without masks.
+  const std::string masks_file = JoinPaths(dir, "masks_file");
+  WriteTestWorkspace(masks_file, MakePlaneModel());
+  WriteFileAtomically(JoinPaths(masks_file, "masks"), [](std::ostream& out) { out << "x"; });
+  EXPECT_EQ(ErrorOf([&] { Workspace::Read(masks_file); }),
+            "The mask folder " + JoinPaths(masks_file, "masks") + " is a file, not a folder");
+  // Names that leave images/ or name a file two ways: every output of a view is named after
+  // it, so they would be written outside the workspace or over each other's. Sub-folders are
+  // fine.
+  for (const char* bad : {"../a.png", "./a.png", "sub//a.png", "/tmp/a.png", "sub/../a.png"}) {
+    const std::string bad_dir = JoinPaths(dir, "bad_name");
+    std::filesystem::remove_all(bad_dir);
+    Reconstruction named = MakePlaneModel();
+    named.images.at(1).name = bad;
+    WriteReconstruction(named, JoinPaths(bad_dir, "sparse"), ModelFormat::kText);
+    CreateDirs(JoinPaths(bad_dir, "images"));
+    const std::string bad_error = ErrorOf([&] { Workspace::Read(bad_dir); });
+    EXPECT_NE(bad_error.find(JoinPaths(bad_dir, "sparse") + ": image 1 is named '" + bad +
+                             "', which is no path inside " + JoinPaths(bad_dir, "images")),
+              std::string::npos)
+        << bad_error;
+  }
   // A distorted camera: reading works, CameraOf tells the user to undistort.
   const std::string distorted = JoinPaths(dir, "distorted");
   Reconstruction model = MakePlaneModel();

@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
   const auto& table = hairmvs::CommandTable();
   const auto it = table.find(command);
   if (it == table.end()) {
-    std::fprintf(stderr, "hairmvs: unknown command '%s' (see hairmvs help)\n", command.c_str());
+    std::fprintf(stderr, "hairmvs: unknown command '%s' (see hairmvs help)\n",
+                 hairmvs::PrintableText(command).c_str());
     return 1;
   }
   try {
@@ -57,7 +58,9 @@ int main(int argc, char** argv) {
     // What the command printed (its options, its progress) comes first, so that the error is
     // the last line of a log that captures both streams.
     std::fflush(stdout);
-    std::fprintf(stderr, "ERROR: %s\n", hairmvs::DescribeException(e).c_str());
+    // Messages quote files' bytes (a bad config line, a PLY header).
+    std::fprintf(stderr, "ERROR: %s\n",
+                 hairmvs::PrintableText(hairmvs::DescribeException(e)).c_str());
     return 1;
   }
 }

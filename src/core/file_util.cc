@@ -119,6 +119,22 @@ std::string ToLower(std::string s) {
   return s;
 }
 
+std::string PrintableText(const std::string& text) {
+  std::string printable;
+  printable.reserve(text.size());
+  for (const char ch : text) {
+    const auto byte = static_cast<unsigned char>(ch);
+    if ((byte < 0x20 && ch != '\n' && ch != '\t') || byte == 0x7f) {
+      char escaped[5];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", byte);
+      printable += escaped;
+    } else {
+      printable += ch;
+    }
+  }
+  return printable;
+}
+
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims) {
   std::vector<std::string> parts;
   size_t start = 0;

@@ -36,6 +36,9 @@ bool IsSameOrInside(const std::string& inner, const std::string& outer);
 std::string ReadTextFile(const std::string& path);
 std::vector<std::string> ReadLines(const std::string& path);
 std::string StripWhitespace(const std::string& s);
+// `text` with its control bytes (but newlines and tabs) written as \xNN: a message that quotes
+// a file's bytes cannot move the terminal's cursor or retitle its window.
+std::string PrintableText(const std::string& text);
 // `s` with its ASCII letters in lower case (option values and file extensions in any case).
 std::string ToLower(std::string s);
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims);

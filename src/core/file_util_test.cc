@@ -436,5 +436,13 @@ TEST(FileUtil, SplitAndStrip) {
   EXPECT_EQ(JoinStrings({}, ", "), "");
 }
 
+// Control bytes quoted from a file are escaped; newlines, tabs and UTF-8 stay.
+TEST(FileUtil, PrintableTextEscapesControlBytes) {
+  EXPECT_EQ(PrintableText("a\x1b[2J\x1b]0;t\x07" "b\n\tc\x7f"),
+            "a\\x1b[2J\\x1b]0;t\\x07b\n\tc\\x7f");
+  EXPECT_EQ(PrintableText(std::string("a\0b", 3)), "a\\x00b");
+  EXPECT_EQ(PrintableText("h\xc3\xa4ir"), "h\xc3\xa4ir");
+}
+
 }  // namespace
 }  // namespace hairmvs

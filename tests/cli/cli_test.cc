@@ -135,6 +135,11 @@ TEST(Cli, OptionsReachTheirCommandAndErrorsNameThem) {
   EXPECT_NE(output.text.find("--median_filter_px must be 0 or odd, at most 99"), std::string::npos)
       << output.text;
   EXPECT_FALSE(ExistsDir(JoinPaths(dir, "out")));
+  // Control bytes quoted in an error (here a path; a config file's line alike) are escaped.
+  output = RunHairmvs("workspace_info --workspace_path '" + JoinPaths(dir, "x\x1b]0;t\x07") + "'");
+  EXPECT_NE(output.exit_code, 0);
+  EXPECT_NE(output.text.find(JoinPaths(dir, "x\\x1b]0;t\\x07")), std::string::npos) << output.text;
+  EXPECT_EQ(output.text.find('\x1b'), std::string::npos) << output.text;
   std::filesystem::remove_all(dir);
 }
 
