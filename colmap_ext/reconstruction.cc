@@ -94,8 +94,9 @@ void Camera::RequirePinhole(const std::string& where) const {
                              << camera_id << " has model " << ModelName()
                              << (IsDistortedPinholeModel(model_id) ? " with distortion" : "")
                              << "; the dense stage needs undistorted PINHOLE or SIMPLE_PINHOLE "
-                                "cameras (or a model whose distortion is all 0): run `colmap "
-                                "image_undistorter --output_type COLMAP` first");
+                                "cameras (or SIMPLE_RADIAL, RADIAL, OPENCV or FULL_OPENCV with "
+                                "every distortion parameter 0): run `colmap image_undistorter "
+                                "--output_type COLMAP` first");
 }
 
 Eigen::Matrix3d Camera::CalibrationMatrix() const {

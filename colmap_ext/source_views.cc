@@ -345,8 +345,7 @@ std::vector<SourceViewSelection> SelectSourceViews(const Workspace& ws,
   const std::string cfg_path = options.config_path.empty()
                                    ? JoinPaths(ws.StereoPath(), "patch-match.cfg")
                                    : options.config_path;
-  THROW_IF(!options.config_path.empty() && !ExistsFile(cfg_path),
-           "Missing patch-match config (config_path): " << cfg_path);
+  if (!options.config_path.empty()) RequireFile(cfg_path, "patch-match config (config_path)");
   std::vector<PatchMatchProblem> problems;
   std::string origin_prefix;
   // A folder in its place is an error (ReadPatchMatchConfig's), not a missing file.

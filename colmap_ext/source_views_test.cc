@@ -150,6 +150,9 @@ TEST(SourceViews, TriangulationAngleTestsAndConfig) {
   options.config_path = JoinPaths(dir, "missing.cfg");
   EXPECT_NE(ErrorOf([&] { SelectSourceViews(ws, options); }).find("missing.cfg"),
             std::string::npos);
+  options.config_path = dir;  // a folder given: said to be one, not missing
+  EXPECT_EQ(ErrorOf([&] { SelectSourceViews(ws, options); }),
+            "The patch-match config (config_path) " + dir + " is a folder, not a file");
   // A folder in stereo/patch-match.cfg's place is an error, not automatic source views.
   options.config_path.clear();
   const std::string cfg = JoinPaths(dir, "stereo", "patch-match.cfg");

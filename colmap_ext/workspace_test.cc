@@ -222,8 +222,9 @@ TEST(Workspace, DistortedCameraNamesTheModelFolder) {
   const std::string message = ErrorOf([&] { ws.RequireUndistortedCameras(); });
   EXPECT_NE(message.find("Image b.png in " + JoinPaths(dir, "sparse") +
                          ": camera 2 has model OPENCV with distortion; the dense stage needs "
-                         "undistorted PINHOLE or SIMPLE_PINHOLE cameras (or a model whose "
-                         "distortion is all 0): run `colmap image_undistorter"),
+                         "undistorted PINHOLE or SIMPLE_PINHOLE cameras (or SIMPLE_RADIAL, "
+                         "RADIAL, OPENCV or FULL_OPENCV with every distortion parameter 0): run "
+                         "`colmap image_undistorter"),
             std::string::npos)
       << message;
   const std::string bare = ErrorOf([&] { model.cameras.at(2).CalibrationMatrix(); });

@@ -122,7 +122,8 @@ void OptionParser::Add(const std::string& name, std::vector<std::string>* value,
           const std::string item = StripWhitespace(part);
           if (!item.empty()) value->push_back(item);
         }
-        return true;
+        // Separators alone name nothing; taken as "all" (the empty list), they ran every image.
+        return !value->empty() || StripWhitespace(text).empty();
       },
       [value] { return JoinNames(*value); });
 }

@@ -179,6 +179,31 @@ TEST(OptionParser, RejectsUnknownOptionsAndBadValues) {
   }
 }
 
+// A list of names: separators and spaces between them; empty (nothing given) is no names,
+// but separators alone are an error, not "all".
+TEST(OptionParser, NameLists) {
+  for (const auto& [text, expected] :
+       std::vector<std::pair<std::string, std::vector<std::string>>>{
+           {"a.png, b.png;c.png", {"a.png", "b.png", "c.png"}}, {"", {}}, {" ", {}}}) {
+    std::vector<std::string> names = {"old"};
+    OptionParser parser("toy", "a toy command");
+    parser.Add("image_names", &names, "views");
+    std::vector<std::string> args = {"hairmvs", "toy", "--image_names", text};
+    auto argv = Argv(args);
+    ASSERT_TRUE(parser.Parse(static_cast<int>(argv.size()), argv.data())) << text;
+    EXPECT_EQ(names, expected) << text;
+  }
+  std::vector<std::string> names;
+  OptionParser parser("toy", "a toy command");
+  parser.Add("image_names", &names, "views");
+  std::vector<std::string> args = {"hairmvs", "toy", "--image_names", ",,,"};
+  auto argv = Argv(args);
+  const std::string message = testing_util::ErrorOf(
+      [&] { parser.Parse(static_cast<int>(argv.size()), argv.data()); });
+  EXPECT_NE(message.find("--image_names"), std::string::npos) << message;
+  EXPECT_NE(message.find("',,,'"), std::string::npos) << message;
+}
+
 // A word that is not an option (a second value, a forgotten "--") and a number that is not
 // finite are errors naming what was typed, not dropped or taken.
 TEST(OptionParser, RejectsStrayWordsAndNonFiniteNumbers) {

@@ -194,6 +194,9 @@ TEST(Cli, PipelineFromPhotosWithMasksRunsAgain) {
   ASSERT_EQ(output.exit_code, 0) << output.text;
   EXPECT_NE(output.text.find("exists with a mask for every image"), std::string::npos)
       << output.text;
+  EXPECT_NE(output.text.find("The workspace " + dense + " exists and is used as it is"),
+            std::string::npos)
+      << output.text;
   // Without a mask for some image it is refused, naming undistort_masks.
   std::filesystem::remove(JoinPaths(dense, "masks", "g0_c.png.png"));
   output = RunHairmvs(run);
