@@ -94,14 +94,9 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
                           << " is in " << images << " (the first: "
                           << JoinPaths(images, ws.images_without_file_.front()) << ")");
   if (!ws.images_without_file_.empty()) {
-    std::ostringstream names;
-    for (size_t i = 0; i < ws.images_without_file_.size() && i < 5; ++i) {
-      names << (i ? ", " : "") << ws.images_without_file_[i];
-    }
-    if (ws.images_without_file_.size() > 5) names << ", ...";
     LOG(WARNING) << images << " holds " << ws.image_names_.size() << " of the "
                  << ws.model_.images.size() << " images of the model " << sparse
-                 << "; the others (" << names.str()
+                 << "; the others (" << JoinFirstNames(ws.images_without_file_)
                  << ") are neither estimated nor source views, as after `colmap "
                     "image_undistorter --image_list_path`";
   }
@@ -169,11 +164,9 @@ Workspace Workspace::Read(const std::string& path, const std::string& mask_path,
   if (!unmasked.empty()) {
     // COLMAP skips a missing mask silently; here a view without one lets its background into
     // the depth range and the depth map, so say which.
-    std::ostringstream names;
-    for (size_t i = 0; i < unmasked.size() && i < 5; ++i) names << (i ? ", " : "") << unmasked[i];
-    if (unmasked.size() > 5) names << ", ...";
     LOG(WARNING) << ws.mask_path_ << ": no mask for " << unmasked.size() << " of "
-                 << ws.image_names_.size() << " images (" << names.str() << "; expected "
+                 << ws.image_names_.size() << " images (" << JoinFirstNames(unmasked)
+                 << "; expected "
                  << JoinPaths(ws.mask_path_, "<image name>.png")
                  << "): they are processed without a mask";
   }

@@ -147,6 +147,12 @@ std::vector<std::string> SplitString(const std::string& s, const std::string& de
   return parts;
 }
 
+std::string JoinFirstNames(const std::vector<std::string>& parts, size_t max_parts) {
+  if (parts.size() <= max_parts) return JoinStrings(parts, ", ");
+  return JoinStrings(std::vector<std::string>(parts.begin(), parts.begin() + max_parts), ", ") +
+         ", ...";
+}
+
 std::string JoinStrings(const std::vector<std::string>& parts, const std::string& separator) {
   std::string joined;
   for (size_t i = 0; i < parts.size(); ++i) joined += (i ? separator : "") + parts[i];

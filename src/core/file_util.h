@@ -44,6 +44,9 @@ std::string ToLower(std::string s);
 std::vector<std::string> SplitString(const std::string& s, const std::string& delims);
 // The parts with `separator` between them: "a, b" from {"a", "b"} and ", ".
 std::string JoinStrings(const std::vector<std::string>& parts, const std::string& separator);
+// The first `max_parts` parts joined with ", ", and ", ..." after them if there are more: a
+// message's list of names that stays one line.
+std::string JoinFirstNames(const std::vector<std::string>& parts, size_t max_parts = 5);
 
 // Writes `path` atomically: `write` fills a stream for a temporary file next to `path`,
 // which is then renamed to `path`. Parent folders are created. If `write` throws, the

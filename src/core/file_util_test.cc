@@ -434,6 +434,8 @@ TEST(FileUtil, SplitAndStrip) {
   EXPECT_EQ(JoinStrings({"a", "b", "c"}, ", "), "a, b, c");
   EXPECT_EQ(JoinStrings({"a"}, ", "), "a");
   EXPECT_EQ(JoinStrings({}, ", "), "");
+  EXPECT_EQ(JoinFirstNames({"a", "b", "c"}, 3), "a, b, c");
+  EXPECT_EQ(JoinFirstNames({"a", "b", "c"}, 2), "a, b, ...");
 }
 
 // Control bytes quoted from a file are escaped; newlines, tabs and UTF-8 stay.

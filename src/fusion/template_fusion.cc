@@ -233,6 +233,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
     }
     Progress progress("template_fusion read", static_cast<int>(names.size()));
     std::vector<std::string> photometric_only;  // --input_type auto took their first estimate
+    std::vector<std::string> without_map;  // listed, but no map to read
     for (size_t idx = 0; idx < names.size(); ++idx) {
       const std::string& name = names[idx];
       progress.Start(static_cast<int>(idx), name);
@@ -250,6 +251,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       const std::string depth_path = workspace.DepthMapPath(name, type);
       if (!ExistsFile(depth_path)) {
         progress.Stage("no " + type + " depth map, skipped");
+        without_map.push_back(name);
         continue;
       }
       FusionView view;
@@ -288,6 +290,13 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
                    << " views have no .geometric depth map: fused from their .photometric one "
                       "(the first estimate, unfiltered by the source views' agreement): "
                    << JoinStrings(photometric_only, ", ");
+    }
+    // A stereo run not finished yet (a job of an array still running) leaves views out: said
+    // once, as colmap stereo_fusion says "Ignoring image" for each.
+    if (!without_map.empty() && !views.empty()) {
+      LOG(WARNING) << without_map.size() << " of the " << without_map.size() + views.size()
+                   << " views to fuse have no depth map and are left out: "
+                   << JoinFirstNames(without_map);
     }
     THROW_IF(views.empty(),
              workspace.StereoPath()

@@ -844,7 +844,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       maps.ref = load(name);
       THROW_IF(maps.ref == nullptr, workspace.DepthMapPath(name, "photometric")
                                         << ": missing; run orientation_stereo on " << name
-                                        << " first (without geom_consistency_only)");
+                                        << " first (without geom_consistency_only); or "
+                                           "another process is replacing its maps (a view in "
+                                           "two jobs at once)");
       const auto it = consistency_views_of.find(name);
       if (it != consistency_views_of.end()) {
         maps.num_others = it->second.size();

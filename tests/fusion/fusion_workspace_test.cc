@@ -181,6 +181,19 @@ TEST(FusionWorkspace, FusionCfgSaysWhichViewsAreFused) {
           << idx;
     }
   }
+  // A listed view without a depth map (its stereo job not finished) is left out, in a warning.
+  WriteFileAtomically(cfg, [&](std::ostream& out) {
+    out << views[0].name << "\n" << views[1].name << "\n" << views[2].name << "\n";
+  });
+  const Workspace workspace = Workspace::Read(dir);
+  std::filesystem::remove(workspace.DepthMapPath(views[2].name, "geometric"));
+  ::testing::internal::CaptureStderr();
+  EXPECT_EQ(RunTemplateFusion(dir, EveryPixelOneThread(), &timings).num_views, 2);
+  const std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("1 of the 3 views to fuse have no depth map and are left out: " +
+                     views[2].name),
+            std::string::npos)
+      << log;
   // A name that is no image of the model is named with the file.
   WriteFileAtomically(cfg, [&](std::ostream& out) { out << "nowhere.png\n"; });
   const std::string message =
