@@ -22,7 +22,9 @@ struct SynthesizeOptions {
   HairStyle style = HairStyle::kStraight;
   // gantry: the paper's T groups of 4 (centre, left/right 10 degrees apart in azimuth, bottom
   // 10 degrees lower) at 0.6 m from the hair; handheld: views around the head at varied
-  // distance, elevation and small roll.
+  // distance, elevation and small roll. Either way the workspace's model holds the true
+  // cameras: a handheld set here has no structure-from-motion error, unlike the shared
+  // synth_handheld (its mapper's poses, off by 2.2 mm), so its figures are the better ones.
   CameraRigType rig = CameraRigType::kGantry;
   // Gantry groups (1..8, in the order of the shared set: back, back-left, back-right, top...).
   int num_groups = 1;
@@ -59,7 +61,7 @@ struct SynthesizeOptions {
   void ForEachField(Visitor&& v) {
     v("output_path", &output_path, "folder to write dense/ and gt/ into");
     v("style", &style, "straight or curly");
-    v("rig", &rig, "gantry (T groups of 4) or handheld");
+    v("rig", &rig, "gantry (T groups of 4) or handheld (true poses either way)");
     v("num_groups", &num_groups, "gantry: number of T groups (1..8)");
     v("num_views", &num_views, "handheld: number of views (0 = 4 * num_groups)");
     v("width", &width, "image width in pixels (height = 2/3 width)");
