@@ -74,7 +74,8 @@ struct OrientationStereoOptions {
   // Processing resolution: the longer image side is downscaled to at most this (-1: full size).
   // Depth maps are then smaller than the images, as COLMAP's are.
   int max_image_size = -1;
-  // Depth range override in metres (<= 0: ComputeDepthRange, COLMAP's rule from sparse points).
+  // Depth range override in metres (0 or -1: ComputeDepthRange, COLMAP's rule from sparse
+  // points; each on its own).
   double depth_min = -1;
   double depth_max = -1;
   // Depth range from the sparse points inside the view's mask only (COLMAP's percentile rule
@@ -567,8 +568,8 @@ struct OrientationStereoOptions {
     v("mask_path", &mask_path,
       "folder of masks <image name>.png (empty: <workspace>/masks if present)");
     v("max_image_size", &max_image_size, "longer side of the processing resolution (-1: full)");
-    v("depth_min", &depth_min, "depth range start in metres (<= 0: from the sparse points)");
-    v("depth_max", &depth_max, "depth range end in metres (<= 0: from the sparse points)");
+    v("depth_min", &depth_min, "depth range start in metres (0 or -1: from the sparse points)");
+    v("depth_max", &depth_max, "depth range end in metres (0 or -1: from the sparse points)");
     v("depth_range_from_mask", &depth_range_from_mask,
       "depth range from the sparse points inside the mask (COLMAP's rule on them)");
     v("depth_range_from_visual_hull", &depth_range_from_visual_hull,

@@ -491,6 +491,11 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
            "ncc_window_px must be odd, in [1, 511]"},
           {[](OrientationStereoOptions* o) { o->ncc_window_px = 100001; },
            "ncc_window_px must be odd, in [1, 511]"},
+          // Taken as "automatic" without a word, where colmap refuses it.
+          {[](OrientationStereoOptions* o) { o->depth_min = -3; },
+           "depth_min must be > 0, or 0 or -1 (automatic)"},
+          {[](OrientationStereoOptions* o) { o->depth_max = -0.5; },
+           "depth_max must be > 0, or 0 or -1 (automatic)"},
           // Beyond the coarse grid's level it was clamped to it without a word.
           {[](OrientationStereoOptions* o) { o->coarse_first_level = 3; },
            "coarse_first_level must be at most coarse_level and below num_levels"}};

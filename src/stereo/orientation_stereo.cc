@@ -145,6 +145,10 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   std::ostringstream e;
   MrfSolverType solver;
   if (!IsValidMaxImageSize(max_image_size)) e << "max_image_size must be > 0 or -1; ";
+  // -1 (COLMAP's "none given") or 0: from the sparse points; another negative value is a typo,
+  // which colmap refuses too.
+  if (depth_min < 0 && depth_min != -1) e << "depth_min must be > 0, or 0 or -1 (automatic); ";
+  if (depth_max < 0 && depth_max != -1) e << "depth_max must be > 0, or 0 or -1 (automatic); ";
   if (depth_min > 0 && depth_max > 0 && depth_max <= depth_min) {
     e << "depth_max must exceed depth_min; ";
   }
