@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "colmap_ext/mat_io.h"
+#include "colmap_ext/ply.h"
 #include "colmap_ext/test_util.h"
 #include "colmap_ext/workspace.h"
 #include "src/core/file_util.h"
@@ -208,6 +209,41 @@ TEST(Cli, PipelineFromPhotosWithMasksRunsAgain) {
   ASSERT_EQ(output.exit_code, 0) << output.text;
   ExpectRunSummary(output.text,
                    {"workspace frame", "read truth", "labels, filter, noise", "normals, write"});
+  std::filesystem::remove_all(dir);
+}
+
+// What the drop-in writes, colmap stereo_fusion fuses with its defaults: also in a workspace
+// without stereo/*.cfg (not made by colmap image_undistorter), whose fusion.cfg the stereo
+// writes (colmap aborted without it).
+TEST(Cli, ColmapFusesTheDropInsMapsWithItsDefaults) {
+  if (!ExistsFile(HAIRMVS_COLMAP_EXECUTABLE)) {
+    GTEST_SKIP() << "colmap executable not found: " << HAIRMVS_COLMAP_EXECUTABLE;
+  }
+  const std::string dir = testing_util::MakeTestDir("cli_colmap_fusion");
+  const std::string workspace = SynthesizeSmallSet(dir);
+  for (const char* cfg : {"patch-match.cfg", "fusion.cfg"}) {
+    std::filesystem::remove(JoinPaths(workspace, "stereo", cfg));
+  }
+  CommandOutput output = RunHairmvs("patch_match_stereo --workspace_path " + workspace);
+  ASSERT_EQ(output.exit_code, 0) << output.text;
+  const std::string fused = JoinPaths(dir, "fused.ply");
+  const std::string command = std::string("'") + HAIRMVS_COLMAP_EXECUTABLE +
+                              "' stereo_fusion --workspace_path " + workspace +
+                              " --input_type geometric --output_path " + fused + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  std::string log;
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) log.append(buffer, n);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << log;
+  const std::vector<FusedPoint> points = ReadFusedPly(fused);
+  std::printf("colmap stereo_fusion, defaults: %zu points\n", points.size());
+  EXPECT_GT(points.size(), 100u);  // about 310 on this 160 px T group (colmap threads vary it)
+  for (const FusedPoint& p : points) {
+    ASSERT_FALSE(p.visible_image_idxs.empty());
+    for (uint32_t idx : p.visible_image_idxs) ASSERT_LT(idx, 4u);
+  }
   std::filesystem::remove_all(dir);
 }
 
