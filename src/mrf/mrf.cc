@@ -35,6 +35,18 @@ void MrfProblem::Validate() const {
   THROW_IF(!(label_step > 0.0f) || !std::isfinite(label_step),
            "MrfProblem: label_step must be positive and finite (got " << label_step << ")");
   THROW_IF(!(truncation >= 0.0f), "MrfProblem: truncation must be >= 0 (got " << truncation << ")");
+  // NaN compares false in every minimum, which the solvers take in different orders (fmin in
+  // the kernels, std::min on the host): a NaN cost gave each solver other labels than its CPU
+  // twin. +inf is a label ruled out; -inf and NaN are no costs.
+  for (size_t i = 0; i < data_cost.size(); ++i) {
+    THROW_IF(!(data_cost[i] > -std::numeric_limits<float>::infinity()),
+             "MrfProblem: data cost " << data_cost[i] << " at pixel " << i % n << ", label "
+                                      << i / n << " (costs must be numbers, +inf at most)");
+  }
+  for (float offset : label_offset) {
+    THROW_IF(!std::isfinite(offset),
+             "MrfProblem: label offsets must be finite (got " << offset << ")");
+  }
   for (const std::vector<float>* w : {&weight_right, &weight_down}) {
     for (float x : *w) {
       THROW_IF(!(x >= 0.0f) || !std::isfinite(x),
