@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <boost/program_options.hpp>
 #include <cmath>
+#include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -50,10 +52,23 @@ OptionParser::~OptionParser() = default;
 
 namespace {
 
+// A number as typed back: the fewest significant digits (6 at least, as a stream prints) that
+// read back as the same value, so that 0.12 prints as 0.12 and 0.3333333 not as 0.333333 (the
+// printed values are also what the orientation fields' cache compares).
 template <typename T>
 std::string ToText(const T& value) {
   std::ostringstream ss;
-  ss << value;
+  if constexpr (std::is_floating_point_v<T>) {
+    for (int digits = 6; digits <= std::numeric_limits<T>::max_digits10; ++digits) {
+      ss.str("");
+      ss << std::setprecision(digits) << value;
+      std::istringstream back(ss.str());
+      T read = 0;
+      if ((back >> read) && read == value) break;
+    }
+  } else {
+    ss << value;
+  }
   return ss.str();
 }
 

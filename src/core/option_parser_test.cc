@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include "src/core/enum_names.h"
 #include "src/core/file_util.h"
@@ -70,6 +72,14 @@ TEST(OptionParser, ParsesSectionsInColmapStyle) {
   EXPECT_TRUE(parser.WasGiven("Toy.lambda"));
   EXPECT_FALSE(parser.WasGiven("Toy.num_levels"));
   EXPECT_NE(parser.Values().find("Toy.solver = semi_global"), std::string::npos);
+  // Numbers print as typed: the fewest digits (6 at least) that read back as the same value.
+  for (const auto& [value, text] : std::vector<std::pair<double, std::string>>{
+           {0.12, "0.12"}, {0.3333333, "0.3333333"}, {1.0 / 3, "0.3333333333333333"},
+           {1e-4, "0.0001"}, {2.5, "2.5"}}) {
+    options.lambda = value;
+    EXPECT_NE(parser.Values().find("Toy.lambda = " + text + "\n"), std::string::npos)
+        << parser.Values();
+  }
 }
 
 // colmap's --project_path: the .ini's options apply where the command line gives none; its

@@ -79,8 +79,12 @@ std::string OrientationFieldsProvenance(const Workspace& workspace, const std::s
   const std::string mask_path = workspace.MaskPath(name);
   out << "mask " << (mask_path.empty() ? "none" : Fingerprint(mask_path)) << "\n";
   out << "size " << width << " x " << height << "\n";
-  // The options as the commands print them (OptionParser::Values), one per line.
+  // The options as the commands print them (OptionParser::Values), one per line; one that the
+  // fields do not depend on at its default, so that changing it keeps them.
   OrientationFieldOptions copy = options;
+  if (copy.dark_strands) {  // SignedResponseRatio() does not read it then
+    copy.min_positive_response_ratio = OrientationFieldOptions().min_positive_response_ratio;
+  }
   OptionParser parser("orientation_fields", "");
   parser.AddSection("OrientationField", &copy);
   std::istringstream values(parser.Values());
@@ -248,6 +252,12 @@ void WriteOrientationFields(const Workspace& workspace, const std::string& name,
   files.push_back({provenance_path, [&recorded](std::ostream& out) { out << recorded; },
                    /*binary=*/false});
   WriteFilesAtomically(files, /*last_marks_complete=*/true);
+  // Levels beyond these are of the fields replaced, which the provenance no longer lists.
+  for (int l = static_cast<int>(levels.size()); l < OrientationFieldOptions::kMaxLevels; ++l) {
+    const std::string stale = workspace.OrientationMapPath(name, l);
+    std::filesystem::remove(stale, error);
+    THROW_IF(error, "Cannot remove " << stale << ": " << error.message());
+  }
 }
 
 std::vector<FloatMap> ComputeViewOrientationFields(const Workspace& workspace,

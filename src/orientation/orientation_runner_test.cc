@@ -229,6 +229,25 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   // Level k does not depend on how many levels are computed.
   options.num_levels = 1;
   EXPECT_TRUE(read("a.png", options, &why_not).has_value()) << why_not;
+  // Nor, with dark strands, on the bright-strand test's ratio, which is not read then.
+  options = OrientationFieldOptions();
+  options.min_positive_response_ratio = 0.01;
+  EXPECT_TRUE(read("a.png", options, &why_not).has_value()) << why_not;
+  options.dark_strands = false;
+  EXPECT_NE(OrientationFieldsProvenance(workspace, "a.png", kWidth, kHeight, options),
+            OrientationFieldsProvenance(workspace, "a.png", kWidth, kHeight, [] {
+              OrientationFieldOptions bright;
+              bright.dark_strands = false;
+              return bright;
+            }()));
+  // Values that differ past the 6th digit are other values (a stream's default precision made
+  // 0.3333333 and 0.333333 one line, and stale fields were reused).
+  OrientationFieldOptions third, nearly_third;
+  third.confidence_gamma = 0.3333333;
+  nearly_third.confidence_gamma = 0.333333;
+  EXPECT_NE(OrientationFieldsProvenance(workspace, "a.png", kWidth, kHeight, third),
+            OrientationFieldsProvenance(workspace, "a.png", kWidth, kHeight, nearly_third));
+  options = OrientationFieldOptions();
 
   // Another filter option, another size.
   options.dark_strands = false;
@@ -276,6 +295,14 @@ TEST(OrientationMaps, ReusedOnlyWhileTheirProvenanceHolds) {
   WriteOrientationFields(workspace, "a.png", provenance, changed);
   EXPECT_FALSE(ExistsFile(picture0));
   WriteOrientationFields(workspace, "a.png", provenance, levels);
+  EXPECT_EQ(ReadTextFile(provenance_path), written);
+  // Fewer levels than before: the replaced fields' level beyond them goes too, unlisted.
+  std::vector<FloatMap> four = levels;
+  four.push_back(levels.back());
+  WriteOrientationFields(workspace, "a.png", provenance, four);
+  EXPECT_TRUE(ExistsFile(workspace.OrientationMapPath("a.png", 3)));
+  WriteOrientationFields(workspace, "a.png", provenance, levels);
+  EXPECT_FALSE(ExistsFile(workspace.OrientationMapPath("a.png", 3)));
   EXPECT_EQ(ReadTextFile(provenance_path), written);
   // A level that another run replaced after this provenance was written (the same size: the
   // payload tells) is not taken for this provenance's, nor is a provenance of an older hairmvs
