@@ -439,6 +439,11 @@ struct OrientationStereoOptions {
   std::string single_pass_type = "geometric";
   double geom_consistency_max_error_px = 4.0;
   int geom_consistency_min_views = 1;
+  // A view whose ray to a depth's point meets the reference's at less than this does not count
+  // as agreeing (COLMAP's filter_min_triangulation_angle, its default): beside the reference,
+  // it reprojects any depth onto the pixel. The views looking the same way are chosen by their
+  // direction alone and may sit there (video frames).
+  double geom_consistency_min_triangulation_angle_deg = 3.0;
   // 4 px rather than COLMAP's 1: the hair's own depth texture is a few pixels of disparity
   // deep. Measured without the prior (filter only), kept hair pixels / per-pixel median for
   // 3 / 4 / 5 px: synthesised curly T group (defaults, seed 1) 90.7 / 92.3 / 93.5% at
@@ -642,7 +647,11 @@ struct OrientationStereoOptions {
     v("geom_consistency_max_error_px", &geom_consistency_max_error_px,
       "consistency: largest forward-backward reprojection error in px");
     v("geom_consistency_min_views", &geom_consistency_min_views,
-      "consistency: source views that must agree for a pixel to keep its depth");
+      "consistency: views that must agree for a pixel to keep its depth (its sources and, "
+      "per geom_consistency_max_view_angle_deg, the views looking the same way)");
+    v("geom_consistency_min_triangulation_angle_deg",
+      &geom_consistency_min_triangulation_angle_deg,
+      "consistency: a view meeting the pixel's ray at a smaller angle does not count");
     v("geom_prior_weight", &geom_prior_weight,
       "geometric pass: weight of the sources' depth maps as a prior (0: filter only)");
     v("geom_prior_max_error_px", &geom_prior_max_error_px,

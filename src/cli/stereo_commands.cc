@@ -72,6 +72,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
   // hairmvs's defaults, not COLMAP's (2, 1 px, 3 px): see OrientationStereoOptions.
   int filter_min_num_consistent = options.geom_consistency_min_views;
   double filter_geom_consistency_max_cost = options.geom_consistency_max_error_px;
+  double filter_min_triangulation_angle = options.geom_consistency_min_triangulation_angle_deg;
   double geom_consistency_max_cost = options.geom_prior_max_error_px;
   // As colmap patch_match_stereo: views whose maps exist are skipped (a run resumes).
   options.skip_existing = true;
@@ -101,7 +102,10 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
              "geometric pass: reprojection error in px at which the sources' depth maps, as a "
              "prior, cost the most");
   parser.Add("PatchMatchStereo.filter_min_num_consistent", &filter_min_num_consistent,
-             "source views that must agree for a pixel to keep its depth");
+             "views that must agree for a pixel to keep its depth (its sources and the views "
+             "looking the same way: see --OrientationStereo.geom_consistency_max_view_angle_deg)");
+  parser.Add("PatchMatchStereo.filter_min_triangulation_angle", &filter_min_triangulation_angle,
+             "a view meeting the pixel's ray at a smaller angle (degrees) does not agree");
   parser.Add("PatchMatchStereo.filter_geom_consistency_max_cost",
              &filter_geom_consistency_max_cost,
              "largest forward-backward reprojection error in px for a view to agree");
@@ -122,9 +126,7 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
         "PatchMatchStereo.sigma_spatial", "PatchMatchStereo.sigma_color",
         "PatchMatchStereo.num_samples", "PatchMatchStereo.ncc_sigma",
         "PatchMatchStereo.incident_angle_sigma", "PatchMatchStereo.num_iterations",
-        "PatchMatchStereo.filter_min_ncc",
-        "PatchMatchStereo.filter_min_triangulation_angle",
-        "PatchMatchStereo.write_consistency_graph"}) {
+        "PatchMatchStereo.filter_min_ncc", "PatchMatchStereo.write_consistency_graph"}) {
     parser.AddIgnored(name, kPatchMatchOnly);
   }
   parser.AddIgnored("PatchMatchStereo.geom_consistency_regularizer",
@@ -187,6 +189,11 @@ int RunPatchMatchStereoCommand(int argc, char** argv) {
       {"PatchMatchStereo.filter_geom_consistency_max_cost", "OrientationStereo",
        "geom_consistency_max_error_px", filter_geom_consistency_max_cost, 1,
        [&] { options.geom_consistency_max_error_px = filter_geom_consistency_max_cost; }},
+      {"PatchMatchStereo.filter_min_triangulation_angle", "OrientationStereo",
+       "geom_consistency_min_triangulation_angle_deg", filter_min_triangulation_angle, kSame,
+       [&] {
+         options.geom_consistency_min_triangulation_angle_deg = filter_min_triangulation_angle;
+       }},
   };
   // Each colmap option given (on the command line or in a project file) applies, except:
   // - a project file that colmap wrote lists every option, most at colmap's defaults: where

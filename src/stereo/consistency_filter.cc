@@ -25,8 +25,11 @@ bool ForwardBackwardErrorPx(const FusionView& other, const Eigen::Vector3d& worl
 FloatMap FilterDepthMapByConsistency(const FusionView& ref,
                                      const std::vector<const FusionView*>& others,
                                      double max_reprojection_error_px, int min_consistent_views,
+                                     double min_triangulation_angle_deg,
                                      ConsistencyFilterStats* stats) {
   FloatMap filtered = ref.depth;
+  const double max_cos_angle = std::cos(min_triangulation_angle_deg * M_PI / 180);
+  const Eigen::Vector3d ref_center = ref.Center();
   const int width = ref.depth.Width(), height = ref.depth.Height();
   int64_t num_checked = 0, num_kept = 0;
 #pragma omp parallel for schedule(dynamic, 8) reduction(+ : num_checked, num_kept)
@@ -39,6 +42,9 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
       const Eigen::Vector2d centre(col + 0.5, row + 0.5);
       int consistent = 0;
       for (const FusionView* other : others) {
+        const Eigen::Vector3d to_ref = (ref_center - world).normalized();
+        const Eigen::Vector3d to_other = (other->Center() - world).normalized();
+        if (to_ref.dot(to_other) > max_cos_angle) continue;
         double error_px;
         if (ForwardBackwardErrorPx(*other, world, ref.K, ref.R, ref.t, centre, &error_px) &&
             error_px <= max_reprojection_error_px) {

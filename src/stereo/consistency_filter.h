@@ -33,11 +33,14 @@ bool ForwardBackwardErrorPx(const FusionView& other, const Eigen::Vector3d& worl
 // agrees when the pixel's point, scaled along that view's line of sight to the view's depth at
 // the pixel it projects to (SfM convention, nearest pixel), projects back into the reference
 // within max_reprojection_error_px of the pixel's centre (COLMAP's forward-backward
-// reprojection error, so the tolerance in depth scales with the baseline). Maps may differ in
-// size from the images as long as each K matches its map.
+// reprojection error, so the tolerance in depth scales with the baseline). A view whose ray to
+// the point meets the reference's at less than `min_triangulation_angle_deg` does not count
+// (COLMAP's filter_min_triangulation_angle): beside the reference, it reprojects any depth onto
+// the pixel. Maps may differ in size from the images as long as each K matches its map.
 FloatMap FilterDepthMapByConsistency(const FusionView& ref,
                                      const std::vector<const FusionView*>& others,
                                      double max_reprojection_error_px, int min_consistent_views,
+                                     double min_triangulation_angle_deg,
                                      ConsistencyFilterStats* stats = nullptr);
 
 }  // namespace hairmvs

@@ -19,7 +19,7 @@ TEST(ConsistencyFilterTest, KeepsAgreeingDepthsAndDropsAWrongPatch) {
     for (int col = 30; col < 45; ++col) ref.depth.At(row, col) *= 1.3f;
   }
   ConsistencyFilterStats stats;
-  const FloatMap filtered = FilterDepthMapByConsistency(ref, {&left, &right}, 1.0, 1, &stats);
+  const FloatMap filtered = FilterDepthMapByConsistency(ref, {&left, &right}, 1.0, 1, 3.0, &stats);
   EXPECT_EQ(stats.num_checked, 80 * 60);
   for (int row = 20; row < 30; ++row) {
     for (int col = 30; col < 45; ++col) EXPECT_EQ(filtered.At(row, col), 0.0f);
@@ -42,16 +42,34 @@ TEST(ConsistencyFilterTest, NeedsTheRequiredNumberOfAgreeingViews) {
   FusionView wrong = PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1);
   for (float& d : wrong.depth.Data()) d *= 0.7f;  // ~4 px off everywhere
   ConsistencyFilterStats one, two;
-  FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 1, &one);
-  const FloatMap none = FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 2, &two);
+  FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 1, 3.0, &one);
+  const FloatMap none = FilterDepthMapByConsistency(ref, {&left, &wrong}, 1.0, 2, 3.0, &two);
   EXPECT_GT(one.num_kept, 40 * 60);
   EXPECT_EQ(two.num_kept, 0);
   for (float d : none.Data()) EXPECT_EQ(d, 0.0f);
   // No other view: nothing is consistent unless none is required.
   ConsistencyFilterStats zero;
-  const FloatMap kept = FilterDepthMapByConsistency(ref, {}, 1.0, 0, &zero);
+  const FloatMap kept = FilterDepthMapByConsistency(ref, {}, 1.0, 0, 3.0, &zero);
   EXPECT_EQ(zero.num_kept, 80 * 60);
   EXPECT_EQ(kept.Data(), ref.depth.Data());
+}
+
+// A view beside the reference (0.5 degrees at the plane) reprojects any depth onto the pixel:
+// with its map 30% too deep it still agrees everywhere, unless its triangulation angle must
+// reach 3 degrees (COLMAP's filter_min_triangulation_angle); the views 5.7 degrees away count.
+TEST(ConsistencyFilterTest, AViewBesideTheReferenceDoesNotCount) {
+  const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  FusionView beside = PlaneView(Eigen::Vector3d(0.0087, 0, 0), 0.0);
+  for (float& d : beside.depth.Data()) d *= 1.3f;
+  ConsistencyFilterStats any_angle, three_degrees;
+  FilterDepthMapByConsistency(ref, {&beside}, 4.0, 1, 0.0, &any_angle);
+  FilterDepthMapByConsistency(ref, {&beside}, 4.0, 1, 3.0, &three_degrees);
+  EXPECT_GT(any_angle.num_kept, 70 * 60);
+  EXPECT_EQ(three_degrees.num_kept, 0);
+  const FusionView left = PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1);
+  ConsistencyFilterStats with_left;
+  FilterDepthMapByConsistency(ref, {&beside, &left}, 4.0, 1, 3.0, &with_left);
+  EXPECT_GT(with_left.num_kept, 40 * 60);
 }
 
 }  // namespace

@@ -157,6 +157,10 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (num_depths < 3 || num_depths > 4096) e << "num_depths must be in [3, 4096]; ";
   if (!(visual_hull_tolerance_m >= 0)) e << "visual_hull_tolerance_m must be >= 0; ";
   if (!(geom_consistency_max_error_px > 0)) e << "geom_consistency_max_error_px must be > 0; ";
+  if (!(geom_consistency_min_triangulation_angle_deg >= 0 &&
+        geom_consistency_min_triangulation_angle_deg < 90)) {
+    e << "geom_consistency_min_triangulation_angle_deg must be in [0, 90); ";
+  }
   // Upper bounds on weights (and a lower one on sigma_o): the MRF's costs are floats, which
   // overflow (or divide 0 by 0) long before a double does.
   if (!(geom_prior_weight >= 0 && geom_prior_weight <= 1e6)) {
@@ -914,9 +918,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         ScopedStageTimer timer(timings, "consistency");
         for (const auto& [name, estimate] : next) {
           FilteredMap& map = filtered[name];
-          map.depth = FilterDepthMapByConsistency(estimate, maps_of(name).others,
-                                                  options.geom_consistency_max_error_px,
-                                                  options.geom_consistency_min_views, &map.stats);
+          map.depth = FilterDepthMapByConsistency(
+              estimate, maps_of(name).others, options.geom_consistency_max_error_px,
+              options.geom_consistency_min_views,
+              options.geom_consistency_min_triangulation_angle_deg, &map.stats);
           map.K = estimate.K;
           total.num_checked += map.stats.num_checked;
           total.num_kept += map.stats.num_kept;
@@ -991,7 +996,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         ScopedStageTimer timer(timings, "consistency");
         depth = FilterDepthMapByConsistency(*maps.ref, others,
                                             options.geom_consistency_max_error_px,
-                                            options.geom_consistency_min_views, &stats);
+                                            options.geom_consistency_min_views,
+                                            options.geom_consistency_min_triangulation_angle_deg,
+                                            &stats);
       }
       if (filtered) {
         std::printf("  %s: %lld of %lld depths consistent with the maps of %d other view(s)\n",
