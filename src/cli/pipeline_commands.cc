@@ -99,12 +99,11 @@ int RunPipeline(int argc, char** argv) {
   if (ExistsDir(sparse_path) && (!image_path.empty() || !input_path.empty())) {
     // The same command run again, to finish a stopped run: said, so that a workspace path
     // meant to be new is not taken for it unnoticed.
-    (!image_path.empty() && !ExistsDir(image_path) ? LOG(WARNING) : LOG(INFO))
+    const bool no_photos = !image_path.empty() && !ExistsDir(image_path);
+    (no_photos ? LOG(WARNING) : LOG(INFO))
         << "The workspace " << workspace_path << " exists and is used as it is: --image_path "
         << "and --input_path, which only create it, are not read"
-        << (!image_path.empty() && !ExistsDir(image_path)
-                ? " (and --image_path " + image_path + " does not exist)"
-                : "");
+        << (no_photos ? " (and --image_path " + image_path + " does not exist)" : "");
   }
   if (!ExistsDir(sparse_path)) {
     THROW_IF(image_path.empty() || input_path.empty(),

@@ -1,6 +1,7 @@
 #include "src/stereo/consistency_filter.h"
 
 #include <cmath>
+#include <vector>
 
 #include "src/core/depth_geometry.h"
 
@@ -30,6 +31,8 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
   FloatMap filtered = ref.depth;
   const double max_cos_angle = std::cos(min_triangulation_angle_deg * M_PI / 180);
   const Eigen::Vector3d ref_center = ref.Center();
+  std::vector<Eigen::Vector3d> other_centers;
+  for (const FusionView* other : others) other_centers.push_back(other->Center());
   const int width = ref.depth.Width(), height = ref.depth.Height();
   int64_t num_checked = 0, num_kept = 0;
 #pragma omp parallel for schedule(dynamic, 8) reduction(+ : num_checked, num_kept)
@@ -40,13 +43,12 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
       ++num_checked;
       const Eigen::Vector3d world = ref.BackProject(col, row, depth);
       const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+      const Eigen::Vector3d to_ref = (ref_center - world).normalized();
       int consistent = 0;
-      for (const FusionView* other : others) {
-        const Eigen::Vector3d to_ref = (ref_center - world).normalized();
-        const Eigen::Vector3d to_other = (other->Center() - world).normalized();
-        if (to_ref.dot(to_other) > max_cos_angle) continue;
+      for (size_t v = 0; v < others.size(); ++v) {
+        if (to_ref.dot((other_centers[v] - world).normalized()) > max_cos_angle) continue;
         double error_px;
-        if (ForwardBackwardErrorPx(*other, world, ref.K, ref.R, ref.t, centre, &error_px) &&
+        if (ForwardBackwardErrorPx(*others[v], world, ref.K, ref.R, ref.t, centre, &error_px) &&
             error_px <= max_reprojection_error_px) {
           ++consistent;
         }
