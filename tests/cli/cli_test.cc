@@ -25,9 +25,9 @@ struct CommandOutput {
   std::string text;  // stdout and stderr
 };
 
-// Runs `hairmvs <args>`.
-CommandOutput RunHairmvs(const std::string& args) {
-  const std::string command = std::string("'") + HAIRMVS_EXECUTABLE + "' " + args + " 2>&1";
+// Runs the shell command `command_line`, its stderr with its stdout.
+CommandOutput RunCommand(const std::string& command_line) {
+  const std::string command = command_line + " 2>&1";
   CommandOutput output;
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return output;
@@ -37,6 +37,11 @@ CommandOutput RunHairmvs(const std::string& args) {
   const int status = pclose(pipe);
   output.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return output;
+}
+
+// Runs `hairmvs <args>`.
+CommandOutput RunHairmvs(const std::string& args) {
+  return RunCommand(std::string("'") + HAIRMVS_EXECUTABLE + "' " + args);
 }
 
 // A long command ends with its stage table, naming `stages`, and its peak memory.
@@ -227,16 +232,10 @@ TEST(Cli, ColmapFusesTheDropInsMapsWithItsDefaults) {
   CommandOutput output = RunHairmvs("patch_match_stereo --workspace_path " + workspace);
   ASSERT_EQ(output.exit_code, 0) << output.text;
   const std::string fused = JoinPaths(dir, "fused.ply");
-  const std::string command = std::string("'") + HAIRMVS_COLMAP_EXECUTABLE +
-                              "' stereo_fusion --workspace_path " + workspace +
-                              " --input_type geometric --output_path " + fused + " 2>&1";
-  FILE* pipe = popen(command.c_str(), "r");
-  ASSERT_NE(pipe, nullptr);
-  std::string log;
-  char buffer[4096];
-  for (size_t n; (n = fread(buffer, 1, sizeof(buffer), pipe)) > 0;) log.append(buffer, n);
-  const int status = pclose(pipe);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << log;
+  output = RunCommand(std::string("'") + HAIRMVS_COLMAP_EXECUTABLE +
+                      "' stereo_fusion --workspace_path " + workspace +
+                      " --input_type geometric --output_path " + fused);
+  ASSERT_EQ(output.exit_code, 0) << output.text;
   const std::vector<FusedPoint> points = ReadFusedPly(fused);
   std::printf("colmap stereo_fusion, defaults: %zu points\n", points.size());
   EXPECT_GT(points.size(), 100u);  // about 310 on this 160 px T group (colmap threads vary it)
