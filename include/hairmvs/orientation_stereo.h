@@ -225,6 +225,28 @@ struct OrientationStereoOptions {
   // Its unit is the label, uniform in inverse depth by default (depth_sampling): per squared
   // millimetre the smoothness charges near depths more than far ones ((z_far / z_near)^4).
   double lambda = 0.125;
+  // The labels' disparity step at which lambda is given (LabelStepPxPerRadian in
+  // src/stereo/stereo_geometry.h: px per label for a source one radian away, the focal length
+  // times the labels' relative depth step in the middle of the range); each view's lambda is
+  // scaled by (its step / this)^2 (0: lambda as given, per label). The data term sees the
+  // surface at the image's scale, the smoothness in labels: on an image a third the size the
+  // same surface's labels change three times faster per pixel, so that a constant lambda
+  // charges its slope 9 times more against the data term (per view, the data term scales with
+  // the pixels, the squared label step per pixel with 1 / pixels), and flattened the hair far
+  // behind it. Measured on a synthesised straight T group (`hairmvs synthesize --num_groups 1
+  // --width W`, .geometric, per-pixel median; lambda unscaled): W = 320: 35.99 mm with 0.125,
+  // 0.007 / 0.0139 / 0.03 / 0.06: 3.99 / 4.16 / 4.77 / 9.26 mm; W = 480: 4.62 mm with 0.125,
+  // 0.015 / 0.031 / 0.06: 3.17 / 3.27 / 3.17 mm; W = 960: 2.82 mm with 0.125, 0.5: 2.81 mm.
+  // The optimum falls with the square of the size. 4 px: the steps of the 960 px gantry's
+  // views (3.4-4.4 px; synth_handheld's 800 px views 2.3-4.1), where 0.125 was chosen. Scaled
+  // (the views' lambda 0.014 at 320 px, 0.53 at 1920): W = 320 / 480 / 960 / 1920: 4.19 /
+  // 3.24 / 2.81 / 2.60 mm against 35.99 / 4.62 / 2.82 / 2.78 unscaled; synth_straight_gantry
+  // 98.6% / 7.92 / 4.17 mm against 98.7% / 7.93 / 4.17, synth_handheld 92.6% / 9.89 / 4.73 mm
+  // against 93.0% / 9.79 / 4.69 (its lambda 0.04-0.13).
+  // The sources' baselines are left out: a wider one steps more disparity per label, but its
+  // match is no sharper per label (on the 320 px group, g0_l and g0_r, whose sources reach 20
+  // degrees, flattened with 0.125 while g0_c, whose sources are 10 degrees away, did not).
+  double lambda_label_step_px = 4.0;
   // Truncation of the squared label difference of the smoothness term, in coarse labels
   // (<= 0: plain quadratic, as the paper). 8 coarse labels of 128: 4 of 64. 3: the g2 group's
   // .geometric median 4.04 -> 4.25 mm, 99.7 -> 97.6% covered. A quadratic term prefers a ramp
@@ -523,6 +545,11 @@ struct OrientationStereoOptions {
   // 5.61 / 5.70 / 5.52 / 5.38 mm, mean 11.39 / 11.59 / 11.11 / 10.79, 3D median 0.647 / 0.653 /
   // 0.639 / 0.627 mm (50: 2 rounds instead of 3). A lone T group has no such views.
   double geom_consistency_max_view_angle_deg = 90.0;
+  // Of those views, at most this many, the nearest in direction: the prior and the filter read
+  // each one's map, so that without a bound a large workspace's geometric pass grows with the
+  // square of its views (and the prior's device buffer with their number). 30: the shared sets'
+  // views have at most 22.
+  int geom_consistency_max_num_views = 30;
   double geom_consistency_min_inconsistent_fraction = 0.1;
   double geom_consistency_min_gain = 0.01;
   // Estimate on the part of the view that holds its mask (the bounding box, grown past every
@@ -597,7 +624,13 @@ struct OrientationStereoOptions {
       "scale the reference field to this RMS magnitude as guide and smoothness weight (0: off)");
     v("guided_filter_eps", &guided_filter_eps, "guided filter eps (paper: 0.12)");
     v("sigma_o", &sigma_o, "smoothness weight orientation scale (paper: 0.15)");
-    v("lambda", &lambda, "smoothness weight per squared coarse label");
+    v("lambda", &lambda,
+      "smoothness weight per squared coarse label, at lambda_label_step_px");
+    v("lambda_label_step_px", &lambda_label_step_px,
+      "the labels' disparity step (px per label for a source one radian away, in the middle of "
+      "the range) at which lambda is given: each view's lambda is scaled by (its step / this)^2, "
+      "so that the smoothness is the same at any image size and num_depths (0: lambda per label "
+      "as given)");
     v("truncation_labels", &truncation_labels,
       "truncate the quadratic smoothness at this label difference (<= 0: none)");
     v("mrf_solver", &mrf_solver, kMrfSolverNameList);
@@ -649,6 +682,9 @@ struct OrientationStereoOptions {
     v("geom_consistency_min_views", &geom_consistency_min_views,
       "consistency: views that must agree for a pixel to keep its depth (its sources and, "
       "per geom_consistency_max_view_angle_deg, the views looking the same way)");
+    v("geom_consistency_max_num_views", &geom_consistency_max_num_views,
+      "consistency and prior: at most this many views looking the same way, the nearest in "
+      "direction (besides the sources)");
     v("geom_consistency_min_triangulation_angle_deg",
       &geom_consistency_min_triangulation_angle_deg,
       "consistency: a view meeting the pixel's ray at a smaller angle does not count");
@@ -685,6 +721,9 @@ struct OrientationStereoOptions {
   // The factor of a source `view_angle_deg` away from the reference in the orientation cost of
   // `level` (of num_levels used): level0_weight_angle_deg's weights, averaging 1 over the levels.
   double LevelSourceWeight(int level, int num_levels, double view_angle_deg) const;
+  // The smoothness weight of a view whose labels step label_step_px (LabelStepPxPerRadian):
+  // lambda scaled by lambda_label_step_px, or as given without the scaling or a step (0).
+  double ViewLambda(double label_step_px) const;
   // Orientation pyramid levels to compute: the data term's and the coarse stage's grid.
   int PyramidLevels() const { return std::max(num_levels, coarse_level + 1); }
   // The fields this stereo reads: `filter`'s with PyramidLevels() levels (what orientation

@@ -17,12 +17,15 @@ class Progress {
   void Stage(const std::string& stage);
   void Finish();
   double ElapsedSeconds() const { return timer_.ElapsedSeconds(); }
+  // The current item and stage, "g0_b.png: cost volume", for an error raised within them.
+  std::string Where() const { return stage_.empty() ? item_ : item_ + ": " + stage_; }
 
  private:
   std::string task_;
   int total_ = 0;
   int index_ = 0;
   std::string item_;
+  std::string stage_;
   Timer timer_;
 };
 

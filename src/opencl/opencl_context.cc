@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iomanip>
 #include <set>
+#include <new>
 #include <sstream>
 
 #include "kernels/embedded_kernels.h"
@@ -125,6 +126,9 @@ constexpr const char* kOpenCLOutOfMemoryAdvice =
     "allocation)";
 
 std::string DescribeException(const std::exception& e) {
+  if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) {
+    return std::string("out of host memory (") + e.what() + "); " + kOpenCLOutOfMemoryAdvice;
+  }
   const auto* error = dynamic_cast<const cl::Error*>(&e);
   if (error == nullptr) return e.what();
   std::ostringstream message;

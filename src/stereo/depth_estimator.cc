@@ -264,6 +264,16 @@ FloatMap NormalizeOrientationField(const FloatMap& orientation, int radius, floa
   return out;
 }
 
+int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
+                       size_t max_alloc_bytes) {
+  int block = std::max(1, std::min(slice_block, num_labels));
+  if (bytes_per_slice > 0) {
+    const size_t fits = max_alloc_bytes / bytes_per_slice;
+    block = static_cast<int>(std::max<size_t>(1, std::min<size_t>(block, fits)));
+  }
+  return block;
+}
+
 namespace {
 
 // EstimateDepthMap on the reference's whole grid.
@@ -378,10 +388,25 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
                           const std::vector<std::vector<float>>& base, float step) {
     const int gw = levels[grid_level].width, gh = levels[grid_level].height;
     const size_t grid_pixels = static_cast<size_t>(gw) * gh;
+    // The device's buffer first: one beyond its largest allocation is refused, naming its size,
+    // before the host has filled as much memory.
+    cl::Buffer volume =
+        context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * grid_pixels * num_labels);
     std::vector<float> host(grid_pixels * num_labels);
-    cl::Buffer volume = context->Buffer(CL_MEM_READ_WRITE, sizeof(float) * host.size());
     queue.enqueueFillBuffer(volume, 0.0f, 0, sizeof(float) * host.size());
-    const int block = std::max(1, std::min(options.slice_block, num_labels));
+    // The block's largest buffers, per slice at the finest level used: the guided filter's 3
+    // planes (GuidedFilterCL), the colour cost's 6 (CostVolumeCL).
+    const size_t bytes_per_slice = sizeof(float) * (colour ? 6 : 3) *
+                                   static_cast<size_t>(levels[first_level].width) *
+                                   levels[first_level].height;
+    const int block = SliceBlockThatFits(options.slice_block, num_labels, bytes_per_slice,
+                                         context->MaxAllocBytes());
+    if (block < std::min(options.slice_block, num_labels)) {
+      LOG_FIRST_N(INFO, 1) << "--OrientationStereo.slice_block " << options.slice_block
+                           << " lowered to " << block << " so that a block's buffers fit the "
+                           << "device's largest allocation (" << (context->MaxAllocBytes() >> 20)
+                           << " MiB)";
+    }
     // The levels used count for the paper's three (kDataTermLevelsScale), so that the data term
     // keeps its scale against lambda without the finest levels (coarse_first_level) or with
     // fewer levels (num_levels).
@@ -448,6 +473,9 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     return host;
   };
 
+  DepthEstimate estimate;
+  estimate.label_step_px = LabelStepPxPerRadian(ref.camera, labels);
+  estimate.lambda = options.ViewLambda(estimate.label_step_px);
   const double truncation = options.truncation_labels > 0
                                 ? options.truncation_labels * options.truncation_labels
                                 : std::numeric_limits<double>::infinity();
@@ -462,7 +490,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     problem.label_offset = std::move(offset);
     problem.label_step = step;
     problem.truncation = static_cast<float>(truncation);
-    SmoothnessWeights(guide(grid_level), options.lambda, options.sigma_o,
+    SmoothnessWeights(guide(grid_level), estimate.lambda, options.sigma_o,
                       &problem.weight_right, &problem.weight_down);
     MrfResult result = SolveMrf(problem, mrf_options, context);
     *energy = result.energy;
@@ -470,7 +498,6 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     return result.labels;
   };
 
-  DepthEstimate estimate;
   const int num_depths = labels.num_labels;
   const bool two_stage = options.coarse_level > 0 && num_pyramid_levels > 1;
   const int coarse_level = two_stage ? std::min(options.coarse_level, num_pyramid_levels - 1) : 0;

@@ -51,10 +51,21 @@ struct DepthEstimate {
   double coarse_energy = 0;
   double fine_energy = 0;
   int num_valid = 0;
+  // The labels' disparity step (LabelStepPxPerRadian) and the smoothness weight it gave
+  // (OrientationStereoOptions::ViewLambda).
+  double label_step_px = 0;
+  double lambda = 0;
   // With options.write_cost_volume and no prior: the coarse stage's aggregated data term
   // before any prior or bound (coarse grid, one channel per label) and each label's depth.
   CostVolume coarse_data_term;
 };
+
+// Depth slices per block of the cost volume and aggregation: slice_block, at most num_labels
+// and at least 1, and fewer where a block's largest buffer (`bytes_per_slice` per slice) would
+// exceed the device's largest allocation, `max_alloc_bytes` (a GPU's is often a quarter of its
+// memory); 1 even where one slice does not fit (its buffer's error then says so).
+int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
+                       size_t max_alloc_bytes);
 
 // `coarse_volume_cache` (may be null): the coarse stage's aggregated data term, before any
 // prior or bound, which depends only on the views, labels and options; used (and emptied) when

@@ -465,6 +465,9 @@ TEST(OrientationStereoOptions, StrandPlaneOptions) {
     options.geom_consistency_max_view_angle_deg = angle;
     ExpectRefusedNaming(options, "geom_consistency_max_view_angle_deg");
   }
+  options = OrientationStereoOptions();
+  options.geom_consistency_max_num_views = -1;
+  ExpectRefusedNaming(options, "geom_consistency_max_num_views");
   // Upper bounds on sizes and counts (beyond them a run ran out of memory mid-view, or every
   // map came out empty), and a fine band wider than the whole range.
   const std::vector<std::pair<std::function<void(OrientationStereoOptions*)>, std::string>>
@@ -550,6 +553,37 @@ TEST(OrientationStereoOptions, LevelSourceWeightsFollowTheViewAngle) {
   options = OrientationStereoOptions();
   options.level0_weight_angle_power = 0;
   ExpectRefusedNaming(options, "level0_weight_angle_power");
+}
+
+// A block holds slice_block slices unless its largest buffer would not fit the device's largest
+// allocation; never fewer than 1 nor more than the labels.
+TEST(DepthEstimator, SliceBlockFitsTheLargestAllocation) {
+  EXPECT_EQ(SliceBlockThatFits(8, 128, 1000, 1 << 20), 8);
+  EXPECT_EQ(SliceBlockThatFits(8, 5, 1000, 1 << 20), 5);
+  EXPECT_EQ(SliceBlockThatFits(8, 128, 1000, 5999), 5);
+  EXPECT_EQ(SliceBlockThatFits(8, 128, 1000, 999), 1);
+  EXPECT_EQ(SliceBlockThatFits(0, 128, 1000, 1 << 20), 1);
+  // 24 Mpixel without a mask, the orientation cost's 3 planes: 8 slices take 2.1 GiB; a GPU of
+  // 8 GiB whose largest allocation is 2 GiB gets 7.
+  const size_t planes = sizeof(float) * 3 * size_t{6000} * 4000;
+  EXPECT_GT(8 * planes, size_t{2} << 30);
+  EXPECT_EQ(SliceBlockThatFits(8, 128, planes, size_t{2} << 30), 7);
+}
+
+// Each view's lambda is scaled by the square of its labels' step against lambda_label_step_px;
+// as given when that is 0 or the view has no step.
+TEST(OrientationStereoOptions, ViewLambdaFollowsTheLabelStep) {
+  OrientationStereoOptions options;
+  options.lambda = 0.2;
+  options.lambda_label_step_px = 4;
+  EXPECT_NEAR(options.ViewLambda(4.0), 0.2, 1e-12);
+  EXPECT_NEAR(options.ViewLambda(2.0), 0.05, 1e-12);
+  EXPECT_NEAR(options.ViewLambda(12.0), 1.8, 1e-12);
+  EXPECT_NEAR(options.ViewLambda(0.0), 0.2, 1e-12);
+  options.lambda_label_step_px = 0;
+  EXPECT_NEAR(options.ViewLambda(2.0), 0.2, 1e-12);
+  options.lambda_label_step_px = -1;
+  ExpectRefusedNaming(options, "lambda_label_step_px");
 }
 
 // The combined cost's data term is the weighted sum of the orientation and photometric costs'

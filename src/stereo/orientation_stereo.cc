@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <iomanip>
 #include <list>
 #include <map>
 #include <memory>
@@ -28,6 +29,7 @@
 #include "src/core/progress.h"
 #include "src/mrf/mrf.h"
 #include "src/opencl/opencl_context.h"
+#include "src/opencl/opencl_error.h"
 #include "src/orientation/orientation_field.h"
 #include "src/orientation/orientation_maps.h"
 #include "src/stereo/depth_estimator.h"
@@ -126,6 +128,12 @@ int OrientationStereoOptions::WindowPx(int level) const {
   return window_px_level2;
 }
 
+double OrientationStereoOptions::ViewLambda(double label_step_px) const {
+  if (lambda_label_step_px <= 0 || !(label_step_px > 0)) return lambda;
+  const double ratio = label_step_px / lambda_label_step_px;
+  return lambda * ratio * ratio;
+}
+
 double OrientationStereoOptions::LevelSourceWeight(int level, int num_levels,
                                                    double view_angle_deg) const {
   if (level0_weight_angle_deg <= 0 || num_levels <= 1) return 1.0;
@@ -171,6 +179,7 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(geom_consistency_max_view_angle_deg >= 0 && geom_consistency_max_view_angle_deg <= 180)) {
     e << "geom_consistency_max_view_angle_deg must be in [0, 180]; ";
   }
+  if (geom_consistency_max_num_views < 0) e << "geom_consistency_max_num_views must be >= 0; ";
   if (!(geom_consistency_min_inconsistent_fraction >= 0 &&
         geom_consistency_min_inconsistent_fraction <= 1)) {
     e << "geom_consistency_min_inconsistent_fraction must be in [0, 1]; ";
@@ -222,6 +231,9 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   if (!(guide_rms >= 0 && guide_rms <= 1000)) e << "guide_rms must be in [0, 1000]; ";
   if (!(sigma_o >= 1e-6 && sigma_o <= 1e6)) e << "sigma_o must be in [1e-6, 1e6]; ";
   if (!(lambda >= 0 && lambda <= 1e6)) e << "lambda must be in [0, 1e6]; ";
+  if (!(lambda_label_step_px >= 0 && lambda_label_step_px <= 1e3)) {
+    e << "lambda_label_step_px must be in [0, 1000]; ";
+  }
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
   if (mrf_icm_polish_iterations < 0) e << "mrf_icm_polish_iterations must be >= 0; ";
@@ -615,9 +627,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
   Progress progress("orientation_stereo", static_cast<int>(to_estimate.size()));
   // One view's depth map, with the other views' maps as a prior in the geometric pass; nothing
   // when the view has no source views.
-  auto estimate_view = [&](const std::string& name, Progress* progress,
-                           const GeometricPrior* prior,
-                           FirstEstimate* cache) -> std::optional<ViewEstimate> {
+  auto estimate_view_unnamed = [&](const std::string& name, Progress* progress,
+                                   const GeometricPrior* prior,
+                                   FirstEstimate* cache) -> std::optional<ViewEstimate> {
     const auto it = sources_of.find(name);
     if (it == sources_of.end() || it->second.empty()) {
       warn_no_sources(name);
@@ -708,6 +720,44 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const double depth_min = search.depth_min, depth_max = search.depth_max;
     const DepthLabels labels(depth_min, depth_max, options.num_depths,
                              options.depth_sampling == DepthSampling::kInverseDepth);
+    if (prior == nullptr) {
+      // The orientation fields' filters are in pixels: a source that images the hair at
+      // another scale sees other strands' bands, and the match leans behind (measured on a
+      // synthesised T group at 240 px, two sources at 1.5 / 1.9 / 2 times the reference's
+      // scale: per-pixel median 6.49 / 13.47 / 17.84 mm against 6.21, signed +11 to +15 mm).
+      constexpr double kMaxImageScaleRatio = 1.6;
+      const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
+      for (size_t s = 0; s < sources.size(); ++s) {
+        const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
+        if (ratio > 0 && (ratio > kMaxImageScaleRatio || ratio < 1 / kMaxImageScaleRatio)) {
+          LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
+                       << std::setprecision(3) << ratio
+                       << " times this view's scale (px per metre at " << depth_mid
+                       << " m); orientation fields do not match across scales, so that its "
+                          "depths lean behind: give the views one scale (images of one size, "
+                          "--OrientationStereo.max_image_size) or other sources "
+                          "(stereo/patch-match.cfg)";
+        }
+        // Eq. 5's roll is one angle per pair, that of the epipole seen from the principal
+        // point: where the epipole lies in the image (a source ahead or behind), the direction
+        // to it, and so the roll, changes across the image.
+        const StereoCamera& src = sources[s]->camera;
+        const Eigen::Vector3d epipole =
+            ref.camera.K * (ref.camera.R * src.Center() + ref.camera.t);
+        if (options.orientation_transfer == OrientationTransfer::kEpipoleRoll &&
+            std::abs(epipole.z()) > 0) {
+          const Eigen::Vector2d e = epipole.hnormalized();
+          if (e.x() >= 0 && e.x() <= ref.camera.width && e.y() >= 0 &&
+              e.y() <= ref.camera.height) {
+            LOG(WARNING) << name << ": source " << source_names[s] << "'s epipole lies in the "
+                         << "image, at (" << e.x() << ", " << e.y() << ") px, where the epipole "
+                         << "roll correction is no single angle: its orientation cost is wrong "
+                            "there; --OrientationStereo.orientation_transfer plane_homography "
+                            "(the default) carries each orientation itself";
+          }
+        }
+      }
+    }
 
     DepthEstimate estimate = EstimateDepthMap(
         context.get(), ref, sources, mask, search.visual_hull_entry, labels, options, timings,
@@ -717,14 +767,27 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const std::string prior_maps =
         prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
                          : "";
-    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %d valid pixels, "
-                "MRF energy %.4g (coarse) %.4g (fine)\n",
+    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and radian, "
+                "lambda %.4g, %d valid pixels, MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
                 depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
-                prior_maps.c_str(), estimate.num_valid, estimate.coarse_energy,
-                estimate.fine_energy);
+                prior_maps.c_str(), estimate.label_step_px, estimate.lambda,
+                estimate.num_valid, estimate.coarse_energy, estimate.fine_energy);
     std::fflush(stdout);
     return ViewEstimate{std::move(estimate), ref.camera.K};
+  };
+  // The same, with the view and stage named in an error that does not name them: a failed
+  // OpenCL call or memory that ran out, which can strike anywhere.
+  auto estimate_view = [&](const std::string& name, Progress* progress,
+                           const GeometricPrior* prior,
+                           FirstEstimate* cache) -> std::optional<ViewEstimate> {
+    try {
+      return estimate_view_unnamed(name, progress, prior, cache);
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception& e) {
+      HAIRMVS_THROW(progress->Where() << ": " << DescribeException(e));
+    }
   };
   // What the geometric pass would compute again, per view, within the memory budget.
   std::map<std::string, FirstEstimate> first_estimates;
@@ -812,13 +875,33 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       const std::set<std::string> in_run(names.begin(), names.end());
       for (const std::string& name : to_filter) {
         std::vector<std::string>& views = consistency_views_of[name];
+        std::vector<std::string> same_way;
         for (std::string& other : ViewsLookingTheSameWay(
                  workspace, name, views, options.geom_consistency_max_view_angle_deg)) {
           if ((options.geom_consistency_only || in_run.count(other) > 0) &&
               sources_of.count(other) > 0) {
-            views.push_back(std::move(other));
+            same_way.push_back(std::move(other));
           }
         }
+        // The nearest in direction, so that a large workspace's prior and filter read a bounded
+        // number of maps per view (each such view's map sits in the prior's device buffer).
+        const size_t max_views = static_cast<size_t>(options.geom_consistency_max_num_views);
+        if (same_way.size() > max_views) {
+          const Eigen::Vector3d direction = workspace.ImageByName(name).ViewingDirection();
+          std::vector<std::pair<double, size_t>> by_cosine;  // larger: nearer in direction
+          for (size_t i = 0; i < same_way.size(); ++i) {
+            by_cosine.emplace_back(
+                -direction.dot(workspace.ImageByName(same_way[i]).ViewingDirection()), i);
+          }
+          std::sort(by_cosine.begin(), by_cosine.end());
+          std::vector<size_t> kept;
+          for (size_t k = 0; k < max_views; ++k) kept.push_back(by_cosine[k].second);
+          std::sort(kept.begin(), kept.end());  // image order, as without the bound
+          std::vector<std::string> nearest;
+          for (size_t i : kept) nearest.push_back(std::move(same_way[i]));
+          same_way = std::move(nearest);
+        }
+        for (std::string& other : same_way) views.push_back(std::move(other));
       }
     }
     auto load = [&](const std::string& name) -> const FusionView* {

@@ -36,6 +36,21 @@ double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b) {
   return std::acos(c) * 180.0 / M_PI;
 }
 
+double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double depth) {
+  const Eigen::Vector3d point = ref.R.transpose() * (Eigen::Vector3d(0, 0, depth) - ref.t);
+  const double z_src = src.R.row(2).dot(point) + src.t.z();
+  if (!(z_src > 0) || !(depth > 0)) return 0.0;
+  const auto focal = [](const StereoCamera& c) { return std::sqrt(c.K(0, 0) * c.K(1, 1)); };
+  return (focal(src) / z_src) / (focal(ref) / depth);
+}
+
+double LabelStepPxPerRadian(const StereoCamera& ref, const DepthLabels& labels) {
+  const double v = 0.5 * (labels.num_labels - 1);
+  const double near = labels.Depth(v), far = labels.Depth(v + 1);
+  const double focal = std::sqrt(ref.K(0, 0) * ref.K(1, 1));
+  return focal * std::abs(1.0 / near - 1.0 / far) * 0.5 * (near + far);
+}
+
 ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera& src,
                                      OrientationTransfer transfer) {
   // X_src = R_rel X_ref + t_rel, X_ref = D K_r^-1 x.

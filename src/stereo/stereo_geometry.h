@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <vector>
 
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/depth_geometry.h"  // StereoCamera
@@ -71,6 +72,13 @@ double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_cen
 // The angle in degrees between two cameras' optical axes.
 double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b);
 
+// How much larger `src` images the point of the reference's optical axis at z-depth `depth`
+// than the reference does: (f_src / z_src) / (f_ref / depth), the focal lengths (geometric mean
+// of fx and fy, px) over each camera's z-depth of the point; 0 when the point lies behind
+// `src`. The orientation fields' filters are in pixels: across a ratio far from 1 they see the
+// strands at other scales.
+double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double depth);
+
 // Depth labels: label value v in [0, num_labels - 1] (fractional values allowed) maps to
 // t = a + b v, depth = t (uniform in depth) or 1 / t (uniform in inverse depth).
 struct DepthLabels {
@@ -90,5 +98,12 @@ struct DepthLabels {
   // Inverse of Depth().
   double Label(double depth) const { return ((inverse ? 1.0 / depth : depth) - a) / b; }
 };
+
+// The disparity step of one label in the middle of the range, v = (num_labels - 1) / 2, for
+// a source one radian of view angle away: the reference's focal length (px) times the labels'
+// relative depth step there, |1 / Depth(v) - 1 / Depth(v + 1)| * (Depth(v) + Depth(v + 1)) / 2.
+// Grows with the image size and the labels' spacing (num_depths, the range); a real source's
+// step is this times its angle, about.
+double LabelStepPxPerRadian(const StereoCamera& ref, const DepthLabels& labels);
 
 }  // namespace hairmvs

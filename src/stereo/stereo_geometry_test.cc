@@ -64,6 +64,46 @@ TEST(StereoGeometry, DepthLabelsSpanTheRangeInDepthOrInverseDepth) {
   EXPECT_NEAR(linear.Depth(1), 1.25, 1e-12);
 }
 
+// The label step is what a real source sees: for a source moved sideways by B, the disparity
+// between the two middle labels' points of the reference's axis is the step times B over their
+// mean depth (the angle the baseline subtends there), exactly for a sideways translation. It
+// grows with the image's size and shrinks with more labels.
+TEST(StereoGeometry, LabelStepIsTheDisparityOfOneLabelPerRadian) {
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 700, 640, 480);
+  for (bool inverse : {true, false}) {
+    const DepthLabels labels(0.4, 0.9, 128, inverse);
+    const double step = LabelStepPxPerRadian(ref, labels);
+    const double near = labels.Depth(63.5), far = labels.Depth(64.5);
+    for (double baseline : {0.02, 0.1}) {
+      const StereoCamera src = LookAtCamera({baseline, 0, 0}, {baseline, 0, 1}, 700, 640, 480);
+      auto project = [&](double depth) -> Eigen::Vector2d {
+        return (src.K * (src.R * Eigen::Vector3d(0, 0, depth) + src.t)).hnormalized();
+      };
+      EXPECT_NEAR((project(near) - project(far)).norm(),
+                  step * baseline / (0.5 * (near + far)), 1e-9 * step)
+          << inverse << " " << baseline;
+    }
+    EXPECT_NEAR(LabelStepPxPerRadian(ref.Scaled(1280, 960), labels), 2 * step, 1e-9 * step);
+    EXPECT_LT(LabelStepPxPerRadian(ref, DepthLabels(0.4, 0.9, 256, inverse)), 0.51 * step);
+  }
+}
+
+// A source twice as far from the point, or with half the focal length, images it at half the
+// scale; one looking at it from the side at the same distance, at the same scale.
+TEST(StereoGeometry, ImageScaleRatioComparesEachCamerasPixelsAtThePoint) {
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 700, 640, 480);
+  EXPECT_NEAR(ImageScaleRatio(ref, ref, 1.0), 1.0, 1e-12);
+  EXPECT_NEAR(ImageScaleRatio(ref, LookAtCamera({0, 0, -1}, {0, 0, 1}, 700, 640, 480), 1.0),
+              0.5, 1e-12);
+  EXPECT_NEAR(ImageScaleRatio(ref, LookAtCamera({0, 0, 0}, {0, 0, 1}, 350, 320, 240), 1.0), 0.5,
+              1e-12);
+  EXPECT_NEAR(ImageScaleRatio(ref, ref.Scaled(1280, 960), 1.0), 2.0, 1e-12);
+  const StereoCamera side = LookAtCamera({1, 0, 1}, {0, 0, 1}, 700, 640, 480);
+  EXPECT_NEAR(ImageScaleRatio(ref, side, 1.0), 1.0, 1e-12);
+  // Behind the source: no scale.
+  EXPECT_EQ(ImageScaleRatio(ref, LookAtCamera({0, 0, 2}, {0, 0, 3}, 700, 640, 480), 1.0), 0.0);
+}
+
 // A strand in the fronto-parallel plane of the reference, seen from a source that is rolled,
 // above and to the side (no pure roll about the baseline): TransferDirection gives its
 // direction in the source exactly, where the epipole roll is only an approximation.

@@ -238,7 +238,9 @@ TEST(Cli, ColmapFusesTheDropInsMapsWithItsDefaults) {
   ASSERT_EQ(output.exit_code, 0) << output.text;
   const std::vector<FusedPoint> points = ReadFusedPly(fused);
   std::printf("colmap stereo_fusion, defaults: %zu points\n", points.size());
-  EXPECT_GT(points.size(), 100u);  // about 310 on this 160 px T group (colmap threads vary it)
+  // About 75 on this 160 px T group (colmap's threads vary it): its strands are a twentieth of
+  // a pixel wide, so that few depths of its rough maps meet colmap's default consistency.
+  EXPECT_GT(points.size(), 30u);
   for (const FusedPoint& p : points) {
     ASSERT_FALSE(p.visible_image_idxs.empty());
     for (uint32_t idx : p.visible_image_idxs) ASSERT_LT(idx, 4u);

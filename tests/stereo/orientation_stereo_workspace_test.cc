@@ -773,10 +773,17 @@ TEST(OrientationStereoWorkspace, GeometricPassAlsoReadsTheViewsLookingTheSameWay
   RunOrientationStereo(path, {"v0.png"}, options, &timings);
   EXPECT_EQ(num_kept("v0.png"), 0);
   options.geom_consistency_only = true;
-  // Views beyond the angle are not read.
+  // Views beyond the angle are not read, nor beyond geom_consistency_max_num_views.
   options.geom_consistency_max_view_angle_deg = 10;
   RunOrientationStereo(path, {}, options, &timings);
   EXPECT_EQ(num_kept("v0.png"), 0);
+  options.geom_consistency_max_view_angle_deg = 20;
+  options.geom_consistency_max_num_views = 0;
+  RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_EQ(num_kept("v0.png"), 0);
+  options.geom_consistency_max_num_views = 1;
+  RunOrientationStereo(path, {}, options, &timings);
+  EXPECT_GT(num_kept("v0.png"), 96 * 72 / 2);
   std::filesystem::remove_all(path);
 }
 
