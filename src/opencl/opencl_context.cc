@@ -120,8 +120,9 @@ void ResolveIncludesInText(const std::string& file, const std::string& text,
 // What to do when the device is out of memory: the end of both messages that say so.
 constexpr const char* kOpenCLOutOfMemoryAdvice =
     "smaller images (--OrientationStereo.max_image_size; orientation_fields' --max_image_size), "
-    "fewer depth slices per block on the device (--OrientationStereo.slice_block: the guided "
-    "filter's and the colour cost's largest buffers grow with it), or --OpenCL.device of "
+    "fewer labels (--OrientationStereo.num_depths, fine_num_labels: the cost volumes grow with "
+    "them), fewer depth slices per block on the device (--OrientationStereo.slice_block: the "
+    "guided filter's and the colour cost's largest buffers grow with it), or --OpenCL.device of "
     "another device (`hairmvs opencl_devices` lists each device's memory and largest "
     "allocation)";
 

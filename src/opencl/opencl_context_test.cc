@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdio>
 #include <cstdlib>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -140,6 +141,10 @@ TEST(OpenCLContext, FailedCallsAreDescribed) {
   }
   EXPECT_EQ(OpenCLErrorString(CL_MAP_FAILURE), "CL_MAP_FAILURE (-12)");
   EXPECT_EQ(DescribeException(Error("plain")), "plain");
+  // Host memory that ran out: said so, with the same advice.
+  const std::string host = DescribeException(std::bad_alloc());
+  EXPECT_EQ(host.rfind("out of host memory", 0), 0u) << host;
+  EXPECT_NE(host.find("--OrientationStereo.max_image_size"), std::string::npos) << host;
 }
 
 // A buffer beyond the device's largest allocation is refused before it is asked for, naming its

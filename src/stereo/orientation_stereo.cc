@@ -776,17 +776,18 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     std::fflush(stdout);
     return ViewEstimate{std::move(estimate), ref.camera.K};
   };
-  // The same, with the view and stage named in an error that does not name them: a failed
-  // OpenCL call or memory that ran out, which can strike anywhere.
+  // The same, with the view and stage named in an error that does not name the view: a failed
+  // OpenCL call, a buffer beyond the device's limit or memory that ran out, which can strike
+  // anywhere.
   auto estimate_view = [&](const std::string& name, Progress* progress,
                            const GeometricPrior* prior,
                            FirstEstimate* cache) -> std::optional<ViewEstimate> {
     try {
       return estimate_view_unnamed(name, progress, prior, cache);
-    } catch (const Error&) {
-      throw;
     } catch (const std::exception& e) {
-      HAIRMVS_THROW(progress->Where() << ": " << DescribeException(e));
+      const std::string message = DescribeException(e);
+      if (message.rfind(name + ":", 0) == 0) throw;
+      HAIRMVS_THROW(progress->Where() << ": " << message);
     }
   };
   // What the geometric pass would compute again, per view, within the memory budget.
