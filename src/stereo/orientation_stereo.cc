@@ -767,8 +767,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const std::string prior_maps =
         prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
                          : "";
-    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and radian, "
-                "lambda %.4g, %d valid pixels, MRF energy %.4g (coarse) %.4g (fine)\n",
+    std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and "
+                "radian, lambda %.4g, %d valid pixels, MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
                 depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
                 prior_maps.c_str(), estimate.label_step_px, estimate.lambda,
@@ -889,7 +889,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         const size_t max_views = static_cast<size_t>(options.geom_consistency_max_num_views);
         if (same_way.size() > max_views) {
           const Eigen::Vector3d direction = workspace.ImageByName(name).ViewingDirection();
-          std::vector<std::pair<double, size_t>> by_cosine;  // larger: nearer in direction
+          std::vector<std::pair<double, size_t>> by_cosine;  // -cos: the nearest sort first
           for (size_t i = 0; i < same_way.size(); ++i) {
             by_cosine.emplace_back(
                 -direction.dot(workspace.ImageByName(same_way[i]).ViewingDirection()), i);
