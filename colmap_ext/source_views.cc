@@ -487,6 +487,24 @@ DepthRange ComputeDepthRange(const Reconstruction& model, uint32_t image_id,
   return ComputeDepthRange(model, image_id);
 }
 
+std::vector<std::string> NearestInDirection(const Workspace& ws, const std::string& reference,
+                                            const std::vector<std::string>& candidates,
+                                            size_t max_num_views) {
+  if (candidates.size() <= max_num_views) return candidates;
+  const Eigen::Vector3d direction = ws.ImageByName(reference).ViewingDirection();
+  std::vector<std::pair<double, size_t>> by_cosine;  // -cos: the nearest sort first
+  for (size_t i = 0; i < candidates.size(); ++i) {
+    by_cosine.emplace_back(-direction.dot(ws.ImageByName(candidates[i]).ViewingDirection()), i);
+  }
+  std::sort(by_cosine.begin(), by_cosine.end());
+  std::vector<size_t> kept;
+  for (size_t k = 0; k < max_num_views; ++k) kept.push_back(by_cosine[k].second);
+  std::sort(kept.begin(), kept.end());
+  std::vector<std::string> nearest;
+  for (size_t i : kept) nearest.push_back(candidates[i]);
+  return nearest;
+}
+
 std::vector<std::string> ViewsLookingTheSameWay(const Workspace& ws, const std::string& reference,
                                                 const std::vector<std::string>& exclude,
                                                 double max_view_angle_deg) {

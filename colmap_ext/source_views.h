@@ -117,6 +117,13 @@ std::vector<std::string> ViewsLookingTheSameWay(const Workspace& ws, const std::
                                                 const std::vector<std::string>& exclude,
                                                 double max_view_angle_deg);
 
+// Of `candidates` (names of the workspace's images), the `max_num_views` whose viewing
+// directions lie nearest the reference's, in their order in `candidates`; all of them when
+// there are no more (ties keep the earlier).
+std::vector<std::string> NearestInDirection(const Workspace& ws, const std::string& reference,
+                                            const std::vector<std::string>& candidates,
+                                            size_t max_num_views);
+
 struct DepthRange {
   double min_m = -1;
   double max_m = -1;

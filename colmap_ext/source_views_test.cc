@@ -355,6 +355,18 @@ TEST(SourceViews, ViewsLookingTheSameWayAreWithinTheAngleOfTheReferencesAxis) {
             (std::vector<std::string>{"c.png"}));
   EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 10), (std::vector<std::string>{}));
   EXPECT_EQ(ViewsLookingTheSameWay(ws, "a.png", {}, 180).size(), 4u);
+  // The nearest of them in direction, in their given order: from a, b (20 degrees), c (45),
+  // d (60), e (120).
+  const std::vector<std::string> others = {"e.png", "d.png", "c.png", "b.png"};
+  EXPECT_EQ(NearestInDirection(ws, "a.png", others, 2),
+            (std::vector<std::string>{"c.png", "b.png"}));
+  EXPECT_EQ(NearestInDirection(ws, "a.png", others, 3),
+            (std::vector<std::string>{"d.png", "c.png", "b.png"}));
+  EXPECT_EQ(NearestInDirection(ws, "a.png", others, 0), (std::vector<std::string>{}));
+  EXPECT_EQ(NearestInDirection(ws, "a.png", others, 4), others);
+  // From d: c (15 degrees), b (40), before a and e (60 both).
+  EXPECT_EQ(NearestInDirection(ws, "d.png", {"e.png", "a.png", "b.png", "c.png"}, 2),
+            (std::vector<std::string>{"b.png", "c.png"}));
 }
 
 TEST(DepthRange, ColmapRuleAndOverrides) {

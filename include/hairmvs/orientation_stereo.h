@@ -246,6 +246,8 @@ struct OrientationStereoOptions {
   // The sources' baselines are left out: a wider one steps more disparity per label, but its
   // match is no sharper per label (on the 320 px group, g0_l and g0_r, whose sources reach 20
   // degrees, flattened with 0.125 while g0_c, whose sources are 10 degrees away, did not).
+  // truncation_labels stays in labels (a depth jump between layers, not a slope): with more
+  // labels it is rescaled by hand as before.
   double lambda_label_step_px = 4.0;
   // Truncation of the squared label difference of the smoothness term, in coarse labels
   // (<= 0: plain quadratic, as the paper). 8 coarse labels of 128: 4 of 64. 3: the g2 group's
@@ -548,7 +550,7 @@ struct OrientationStereoOptions {
   // Of those views, at most this many, the nearest in direction: the prior and the filter read
   // each one's map, so that without a bound a large workspace's geometric pass grows with the
   // square of its views (and the prior's device buffer with their number). 30: the shared sets'
-  // views have at most 22.
+  // views have at most 22. 0: the sources only.
   int geom_consistency_max_num_views = 30;
   double geom_consistency_min_inconsistent_fraction = 0.1;
   double geom_consistency_min_gain = 0.01;
@@ -629,8 +631,8 @@ struct OrientationStereoOptions {
     v("lambda_label_step_px", &lambda_label_step_px,
       "the labels' disparity step (px per label for a source one radian away, in the middle of "
       "the range) at which lambda is given: each view's lambda is scaled by (its step / this)^2, "
-      "so that the smoothness is the same at any image size and num_depths (0: lambda per label "
-      "as given)");
+      "so that the smoothness's quadratic part is the same at any image size and num_depths "
+      "(truncation_labels is not scaled; 0: lambda per label as given; else at least 0.01)");
     v("truncation_labels", &truncation_labels,
       "truncate the quadratic smoothness at this label difference (<= 0: none)");
     v("mrf_solver", &mrf_solver, kMrfSolverNameList);
@@ -684,7 +686,7 @@ struct OrientationStereoOptions {
       "per geom_consistency_max_view_angle_deg, the views looking the same way)");
     v("geom_consistency_max_num_views", &geom_consistency_max_num_views,
       "consistency and prior: at most this many views looking the same way, the nearest in "
-      "direction (besides the sources)");
+      "direction (besides the sources; 0: the sources only)");
     v("geom_consistency_min_triangulation_angle_deg",
       &geom_consistency_min_triangulation_angle_deg,
       "consistency: a view meeting the pixel's ray at a smaller angle does not count");

@@ -126,9 +126,15 @@ constexpr const char* kOpenCLOutOfMemoryAdvice =
     "another device (`hairmvs opencl_devices` lists each device's memory and largest "
     "allocation)";
 
+// What to do when the host's memory ran out (std::bad_alloc).
+constexpr const char* kHostOutOfMemoryAdvice =
+    "smaller images (--OrientationStereo.max_image_size), fewer labels "
+    "(--OrientationStereo.num_depths), a smaller --OrientationStereo.coarse_volume_cache_mib, or "
+    "fewer views per process (--image_names; README, \"Splitting the work on a cluster\")";
+
 std::string DescribeException(const std::exception& e) {
   if (dynamic_cast<const std::bad_alloc*>(&e) != nullptr) {
-    return std::string("out of host memory (") + e.what() + "); " + kOpenCLOutOfMemoryAdvice;
+    return std::string("out of host memory (") + e.what() + "); " + kHostOutOfMemoryAdvice;
   }
   const auto* error = dynamic_cast<const cl::Error*>(&e);
   if (error == nullptr) return e.what();
@@ -152,6 +158,12 @@ std::string DescribeException(const std::exception& e) {
       break;
   }
   return message.str();
+}
+
+std::string DescribeExceptionWithin(const std::string& item, const std::string& where,
+                                    const std::exception& e) {
+  const std::string message = DescribeException(e);
+  return message.rfind(item + ":", 0) == 0 ? message : where + ": " + message;
 }
 
 std::string OpenCLErrorString(cl_int code) {

@@ -141,10 +141,22 @@ TEST(OpenCLContext, FailedCallsAreDescribed) {
   }
   EXPECT_EQ(OpenCLErrorString(CL_MAP_FAILURE), "CL_MAP_FAILURE (-12)");
   EXPECT_EQ(DescribeException(Error("plain")), "plain");
-  // Host memory that ran out: said so, with the same advice.
+  // Host memory that ran out: said so, with what to do on the host.
   const std::string host = DescribeException(std::bad_alloc());
   EXPECT_EQ(host.rfind("out of host memory", 0), 0u) << host;
   EXPECT_NE(host.find("--OrientationStereo.max_image_size"), std::string::npos) << host;
+  EXPECT_NE(host.find("--image_names"), std::string::npos) << host;
+  EXPECT_EQ(host.find("slice_block"), std::string::npos) << host;
+  // Within a view: prefixed with where it struck, unless the message names the view first.
+  const std::string where = "v0.png: MRF";
+  EXPECT_EQ(DescribeExceptionWithin("v0.png", where, std::bad_alloc()), where + ": " + host);
+  EXPECT_EQ(DescribeExceptionWithin("v0.png", where, cl::Error(CL_OUT_OF_RESOURCES, "clFinish"))
+                .rfind("v0.png: MRF: OpenCL call clFinish failed: CL_OUT_OF_RESOURCES", 0),
+            0u);
+  EXPECT_EQ(DescribeExceptionWithin("v0.png", where, Error("v0.png: no depth range")),
+            "v0.png: no depth range");
+  EXPECT_EQ(DescribeExceptionWithin("v0.png", where, Error("v0.png.bin is missing")),
+            "v0.png: MRF: v0.png.bin is missing");
 }
 
 // A buffer beyond the device's largest allocation is refused before it is asked for, naming its

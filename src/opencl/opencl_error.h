@@ -11,4 +11,10 @@ namespace hairmvs {
 // std::bad_alloc (host memory) what to do too.
 std::string DescribeException(const std::exception& e);
 
+// The message of an error raised while working on `item` at `where` ("g0_c.png: MRF"):
+// DescribeException's, prefixed with `where` unless it begins with the item's name already
+// ("g0_c.png: no depth range ..."): a failed OpenCL call or memory that ran out names neither.
+std::string DescribeExceptionWithin(const std::string& item, const std::string& where,
+                                    const std::exception& e);
+
 }  // namespace hairmvs

@@ -131,8 +131,10 @@ OrientationStereoOptions TestOptions() {
   // 96 x 72 views: the coarse MRF on the half-size grid (level 2 would be 24 x 18).
   options.coarse_level = 1;
   // The rendered fields have |O| = 1 on strands (real ones are weaker): costs are about 10x
-  // those of the shared sets, and so is the smoothness weight.
+  // those of the shared sets, and the smoothness weight was chosen so, per label (unscaled:
+  // these small views' labels step 1.15 px, against the 4 px at which lambda is given).
   options.lambda = 0.02;
+  options.lambda_label_step_px = 0;
   // Windows 7/11/15 from fine to coarse: a 15 px window at level 0 spans a sixth of these
   // images, and its fronto-parallel bias shows on the sphere (10.6 mm median).
   options.window_px_level0 = 7;
@@ -156,6 +158,25 @@ Result ReconstructTiltedPlane(const OrientationStereoOptions& options) {
   plane.point = {0, 0, 1};
   plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
   return Reconstruct(plane, TCameras({0, 0, 1}), 0.7, 1.5, options, 1);
+}
+
+// The MRF weighs the smoothness with the view's scaled lambda: lambda at a label step s is the
+// same estimate as the unscaled ViewLambda(the view's step); without the scaling, another.
+TEST(DepthEstimator, TheMrfUsesTheViewsScaledLambda) {
+  OrientationStereoOptions scaled = TestOptions();
+  scaled.lambda_label_step_px = 0.5;
+  const double step =
+      LabelStepPxPerRadian(TCameras({0, 0, 1})[0], DepthLabels(0.7, 1.5, scaled.num_depths, true));
+  OrientationStereoOptions unscaled = scaled;
+  unscaled.lambda = scaled.ViewLambda(step);
+  unscaled.lambda_label_step_px = 0;
+  EXPECT_GT(unscaled.lambda, 4 * scaled.lambda);  // a step of about 1.15 px
+  const Result a = ReconstructTiltedPlane(scaled), b = ReconstructTiltedPlane(unscaled);
+  EXPECT_EQ(a.depth.Data(), b.depth.Data());
+  EXPECT_EQ(a.fine_energy, b.fine_energy);
+  OrientationStereoOptions plain = scaled;
+  plain.lambda_label_step_px = 0;
+  EXPECT_NE(ReconstructTiltedPlane(plain).fine_energy, a.fine_energy);
 }
 
 TEST(DepthEstimator, RecoversATiltedPlaneCoveredInStrands) {
@@ -584,6 +605,12 @@ TEST(OrientationStereoOptions, ViewLambdaFollowsTheLabelStep) {
   EXPECT_NEAR(options.ViewLambda(2.0), 0.2, 1e-12);
   options.lambda_label_step_px = -1;
   ExpectRefusedNaming(options, "lambda_label_step_px");
+  options.lambda_label_step_px = 1e-30;  // would scale lambda past any float weight
+  ExpectRefusedNaming(options, "lambda_label_step_px");
+  // The scaled weight stays within lambda's own bound.
+  options.lambda = 1e6;
+  options.lambda_label_step_px = 0.01;
+  EXPECT_EQ(options.ViewLambda(1000.0), 1e6);
 }
 
 // The combined cost's data term is the weighted sum of the orientation and photometric costs'

@@ -128,10 +128,17 @@ int OrientationStereoOptions::WindowPx(int level) const {
   return window_px_level2;
 }
 
+namespace {
+// The largest lambda: graph cuts loses double precision at weights of 1e15 and more, and float
+// weights overflow beyond.
+constexpr double kMaxLambda = 1e6;
+}  // namespace
+
 double OrientationStereoOptions::ViewLambda(double label_step_px) const {
   if (lambda_label_step_px <= 0 || !(label_step_px > 0)) return lambda;
   const double ratio = label_step_px / lambda_label_step_px;
-  return lambda * ratio * ratio;
+  // Within lambda's own bound (Check): float smoothness weights overflow beyond.
+  return std::min(lambda * ratio * ratio, kMaxLambda);
 }
 
 double OrientationStereoOptions::LevelSourceWeight(int level, int num_levels,
@@ -230,9 +237,10 @@ bool OrientationStereoOptions::Check(std::string* error) const {
   // Beyond ~1e3 the guide's squares overflow float in the guided filter: every map empty.
   if (!(guide_rms >= 0 && guide_rms <= 1000)) e << "guide_rms must be in [0, 1000]; ";
   if (!(sigma_o >= 1e-6 && sigma_o <= 1e6)) e << "sigma_o must be in [1e-6, 1e6]; ";
-  if (!(lambda >= 0 && lambda <= 1e6)) e << "lambda must be in [0, 1e6]; ";
-  if (!(lambda_label_step_px >= 0 && lambda_label_step_px <= 1e3)) {
-    e << "lambda_label_step_px must be in [0, 1000]; ";
+  if (!(lambda >= 0 && lambda <= kMaxLambda)) e << "lambda must be in [0, 1e6]; ";
+  if (!(lambda_label_step_px == 0 ||
+        (lambda_label_step_px >= 0.01 && lambda_label_step_px <= 1e3))) {
+    e << "lambda_label_step_px must be 0 or in [0.01, 1000]; ";
   }
   if (!FromString(mrf_solver, &solver)) e << "mrf_solver '" << mrf_solver << "' is unknown; ";
   if (mrf_max_cycles < 1) e << "mrf_max_cycles must be >= 1; ";
@@ -743,20 +751,15 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         // Eq. 5's roll is one angle per pair, that of the epipole seen from the principal
         // point: where the epipole lies in the image (a source ahead or behind), the direction
         // to it, and so the roll, changes across the image.
-        const StereoCamera& src = sources[s]->camera;
-        const Eigen::Vector3d epipole =
-            ref.camera.K * (ref.camera.R * src.Center() + ref.camera.t);
+        const Eigen::Vector3d src_center = sources[s]->camera.Center();
         if (options.orientation_transfer == OrientationTransfer::kEpipoleRoll &&
-            std::abs(epipole.z()) > 0) {
-          const Eigen::Vector2d e = epipole.hnormalized();
-          if (e.x() >= 0 && e.x() <= ref.camera.width && e.y() >= 0 &&
-              e.y() <= ref.camera.height) {
-            LOG(WARNING) << name << ": source " << source_names[s] << "'s epipole lies in the "
-                         << "image, at (" << e.x() << ", " << e.y() << ") px, where the epipole "
-                         << "roll correction is no single angle: its orientation cost is wrong "
-                            "there; --OrientationStereo.orientation_transfer plane_homography "
-                            "(the default) carries each orientation itself";
-          }
+            EpipoleInImage(ref.camera, src_center)) {
+          const Eigen::Vector2d e = Epipole(ref.camera, src_center).hnormalized();
+          LOG(WARNING) << name << ": source " << source_names[s] << "'s epipole lies in the "
+                       << "image, at (" << e.x() << ", " << e.y() << ") px, where the epipole "
+                       << "roll correction is no single angle: its orientation cost is wrong "
+                          "there; --OrientationStereo.orientation_transfer plane_homography "
+                          "(the default) carries each orientation itself";
         }
       }
     }
@@ -787,9 +790,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     try {
       return estimate_view_unnamed(name, progress, prior, cache);
     } catch (const std::exception& e) {
-      const std::string message = DescribeException(e);
-      if (message.rfind(name + ":", 0) == 0) throw;
-      HAIRMVS_THROW(progress->Where() << ": " << message);
+      HAIRMVS_THROW(DescribeExceptionWithin(name, progress->Where(), e));
     }
   };
   // What the geometric pass would compute again, per view, within the memory budget.
@@ -888,23 +889,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         }
         // The nearest in direction, so that a large workspace's prior and filter read a bounded
         // number of maps per view (each such view's map sits in the prior's device buffer).
-        const size_t max_views = static_cast<size_t>(options.geom_consistency_max_num_views);
-        if (same_way.size() > max_views) {
-          const Eigen::Vector3d direction = workspace.ImageByName(name).ViewingDirection();
-          std::vector<std::pair<double, size_t>> by_cosine;  // -cos: the nearest sort first
-          for (size_t i = 0; i < same_way.size(); ++i) {
-            by_cosine.emplace_back(
-                -direction.dot(workspace.ImageByName(same_way[i]).ViewingDirection()), i);
-          }
-          std::sort(by_cosine.begin(), by_cosine.end());
-          std::vector<size_t> kept;
-          for (size_t k = 0; k < max_views; ++k) kept.push_back(by_cosine[k].second);
-          std::sort(kept.begin(), kept.end());  // image order, as without the bound
-          std::vector<std::string> nearest;
-          for (size_t i : kept) nearest.push_back(std::move(same_way[i]));
-          same_way = std::move(nearest);
+        for (std::string& other : NearestInDirection(
+                 workspace, name, same_way,
+                 static_cast<size_t>(options.geom_consistency_max_num_views))) {
+          views.push_back(std::move(other));
         }
-        for (std::string& other : same_way) views.push_back(std::move(other));
       }
     }
     auto load = [&](const std::string& name) -> const FusionView* {

@@ -21,8 +21,19 @@ std::array<float, 16> ViewProjection::Packed(float weight) const {
   return packed;
 }
 
+Eigen::Vector3d Epipole(const StereoCamera& camera, const Eigen::Vector3d& other_center) {
+  return camera.K * (camera.R * other_center + camera.t);
+}
+
+bool EpipoleInImage(const StereoCamera& camera, const Eigen::Vector3d& other_center) {
+  const Eigen::Vector3d e = Epipole(camera, other_center);
+  if (e.z() == 0) return false;
+  const Eigen::Vector2d x = e.hnormalized();
+  return x.x() >= 0 && x.x() <= camera.width && x.y() >= 0 && x.y() <= camera.height;
+}
+
 double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_center) {
-  const Eigen::Vector3d e = camera.K * (camera.R * other_center + camera.t);
+  const Eigen::Vector3d e = Epipole(camera, other_center);
   // (e.x / e.z - cx, e.y / e.z - cy) scaled by e.z: the sign of e.z flips the vector, which
   // changes the angle by pi; the correction uses 2 phi, so that does not matter.
   const double vx = e.x() - camera.K(0, 2) * e.z();
@@ -40,15 +51,13 @@ double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double 
   const Eigen::Vector3d point = ref.R.transpose() * (Eigen::Vector3d(0, 0, depth) - ref.t);
   const double z_src = src.R.row(2).dot(point) + src.t.z();
   if (!(z_src > 0) || !(depth > 0)) return 0.0;
-  const auto focal = [](const StereoCamera& c) { return std::sqrt(c.K(0, 0) * c.K(1, 1)); };
-  return (focal(src) / z_src) / (focal(ref) / depth);
+  return (MeanFocalPx(src.K) / z_src) / (MeanFocalPx(ref.K) / depth);
 }
 
 double LabelStepPxPerRadian(const StereoCamera& ref, const DepthLabels& labels) {
   const double v = 0.5 * (labels.num_labels - 1);
   const double near = labels.Depth(v), far = labels.Depth(v + 1);
-  const double focal = std::sqrt(ref.K(0, 0) * ref.K(1, 1));
-  return focal * std::abs(1.0 / near - 1.0 / far) * 0.5 * (near + far);
+  return MeanFocalPx(ref.K) * std::abs(1.0 / near - 1.0 / far) * 0.5 * (near + far);
 }
 
 ViewProjection ComputeViewProjection(const StereoCamera& ref, const StereoCamera& src,

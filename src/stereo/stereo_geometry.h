@@ -7,7 +7,6 @@
 
 #include <Eigen/Core>
 #include <array>
-#include <vector>
 
 #include "hairmvs/orientation_stereo.h"
 #include "src/core/depth_geometry.h"  // StereoCamera
@@ -65,6 +64,14 @@ Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth
 FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
                           double focal_px, double max_tilt_deg);
 
+// The epipole of the camera centred at `other_center` in `camera`'s image, homogeneous
+// (K (R c + t)): z = 0 where it lies at infinity, z < 0 where `other_center` is behind.
+Eigen::Vector3d Epipole(const StereoCamera& camera, const Eigen::Vector3d& other_center);
+
+// Whether that epipole lies within `camera`'s image (x in [0, width], y in [0, height], image
+// coordinates): the other camera is ahead of or behind this one rather than beside it.
+bool EpipoleInImage(const StereoCamera& camera, const Eigen::Vector3d& other_center);
+
 // Angle (radians, modulo pi is what matters) between the image +x axis and the vector from the
 // principal point of `camera` to the epipole of the camera centred at `other_center`.
 double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_center);
@@ -73,9 +80,8 @@ double EpipoleAngle(const StereoCamera& camera, const Eigen::Vector3d& other_cen
 double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b);
 
 // How much larger `src` images the point of the reference's optical axis at z-depth `depth`
-// than the reference does: (f_src / z_src) / (f_ref / depth), the focal lengths (geometric mean
-// of fx and fy, px) over each camera's z-depth of the point; 0 when the point lies behind
-// `src`. The orientation fields' filters are in pixels: across a ratio far from 1 they see the
+// than the reference does: (f_src / z_src) / (f_ref / depth), the focal lengths (MeanFocalPx)
+// over each camera's z-depth of the point; 0 when the point lies behind `src`. The orientation fields' filters are in pixels: across a ratio far from 1 they see the
 // strands at other scales.
 double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double depth);
 
@@ -100,10 +106,10 @@ struct DepthLabels {
 };
 
 // The disparity step of one label in the middle of the range, v = (num_labels - 1) / 2, for
-// a source one radian of view angle away: the reference's focal length (px) times the labels'
-// relative depth step there, |1 / Depth(v) - 1 / Depth(v + 1)| * (Depth(v) + Depth(v + 1)) / 2.
-// Grows with the image size and the labels' spacing (num_depths, the range); a real source's
-// step is this times its angle, about.
+// a source one radian of view angle away: the reference's focal length (MeanFocalPx) times the
+// labels' relative depth step there, |1 / Depth(v) - 1 / Depth(v + 1)| * (Depth(v) +
+// Depth(v + 1)) / 2. Grows with the image size and the labels' spacing (num_depths, the
+// range); a real source's step is this times its angle, about.
 double LabelStepPxPerRadian(const StereoCamera& ref, const DepthLabels& labels);
 
 }  // namespace hairmvs

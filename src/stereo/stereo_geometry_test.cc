@@ -102,6 +102,21 @@ TEST(StereoGeometry, ImageScaleRatioComparesEachCamerasPixelsAtThePoint) {
   EXPECT_NEAR(ImageScaleRatio(ref, side, 1.0), 1.0, 1e-12);
   // Behind the source: no scale.
   EXPECT_EQ(ImageScaleRatio(ref, LookAtCamera({0, 0, 2}, {0, 0, 3}, 700, 640, 480), 1.0), 0.0);
+  // Beside the axis, looking along it: the z-depth counts (1 m), not the distance (1.118 m).
+  const StereoCamera parallel = LookAtCamera({0.5, 0, 0}, {0.5, 0, 1}, 700, 640, 480);
+  EXPECT_NEAR(ImageScaleRatio(ref, parallel, 1.0), 1.0, 1e-12);
+}
+
+// A camera ahead or behind has its epipole in the image; one beside, off it (or at infinity).
+TEST(StereoGeometry, EpipoleInImageOfACameraAheadOrBehind) {
+  const StereoCamera ref = LookAtCamera({0, 0, 0}, {0, 0, 1}, 700, 640, 480);
+  EXPECT_TRUE(EpipoleInImage(ref, {0.01, 0, 0.3}));
+  EXPECT_TRUE(EpipoleInImage(ref, {0, 0.02, -0.5}));
+  EXPECT_FALSE(EpipoleInImage(ref, {0.3, 0, 0}));   // at infinity
+  EXPECT_FALSE(EpipoleInImage(ref, {0.3, 0, 0.1}));  // 2100 px off the principal point
+  const Eigen::Vector2d e = Epipole(ref, {0.01, 0, 0.3}).hnormalized();
+  EXPECT_NEAR(std::abs(e.x() - 320), 700 * 0.01 / 0.3, 1e-9);
+  EXPECT_NEAR(e.y(), 240, 1e-9);
 }
 
 // A strand in the fronto-parallel plane of the reference, seen from a source that is rolled,

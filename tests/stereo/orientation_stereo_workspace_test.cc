@@ -96,6 +96,9 @@ OrientationStereoOptions PlaneOptions() {
   options.depth_min = 0.7;
   options.depth_max = 1.5;
   options.coarse_level = 1;
+  // Lambda per label, as chosen for these small views (their labels step 0.57 px: scaled to the
+  // 4 px at which lambda is given, a fiftieth of it).
+  options.lambda_label_step_px = 0;
   return options;
 }
 
