@@ -212,7 +212,8 @@ struct OrientationStereoOptions {
   // the g2 group 4.05 / 4.06 / 4.07 mm against 4.02 (the interior 2.98 / 2.98 / 2.99 against
   // 2.96, the silhouette band 5.96 / 6.01 / 6.01 against 5.89).
   double sigma_o = 0.15;
-  // lambda of E = E_d + lambda E_s, per squared coarse label (not given in the paper). With
+  // lambda of E = E_d + lambda E_s, per squared coarse label (not given in the paper), for
+  // labels lambda_label_step_px apart (below: each view's is scaled to its own). With
   // the normalised fields, on synth_straight_gantry g0_c + g0_l: 0.02 / 0.1 / 0.5 / 2 gave
   // per-pixel medians of 9.1 / 7.2 / 6.1 / 6.4 mm. (With the raw fields, whose costs are about
   // 100x smaller, 0.002 was best: 0.0005 / 0.002 / 0.008 / 0.05 gave 38 / 15 / 32 / 56 mm.)
