@@ -96,7 +96,8 @@ int RunPipeline(int argc, char** argv) {
   Timer total;
   StageTimings timings;
   const std::string sparse_path = JoinPaths(workspace_path, "sparse");
-  if (ExistsDir(sparse_path) && (!image_path.empty() || !input_path.empty())) {
+  const bool workspace_exists = ExistsDir(sparse_path);
+  if (workspace_exists && (!image_path.empty() || !input_path.empty())) {
     // The same command run again, to finish a stopped run: said, so that a workspace path
     // meant to be new is not taken for it unnoticed.
     const bool no_photos = !image_path.empty() && !ExistsDir(image_path);
@@ -105,7 +106,7 @@ int RunPipeline(int argc, char** argv) {
         << "and --input_path, which only create it, are not read"
         << (no_photos ? " (and --image_path " + image_path + " does not exist)" : "");
   }
-  if (!ExistsDir(sparse_path)) {
+  if (!workspace_exists) {
     THROW_IF(image_path.empty() || input_path.empty(),
              "No COLMAP dense workspace at " << workspace_path << " (missing " << sparse_path
                                              << "); give --image_path and --input_path to "

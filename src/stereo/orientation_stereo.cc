@@ -129,15 +129,14 @@ int OrientationStereoOptions::WindowPx(int level) const {
 }
 
 namespace {
-// The largest lambda: graph cuts loses double precision at weights of 1e15 and more, and float
-// weights overflow beyond.
+// The largest lambda, given or scaled per view (ViewLambda): graph cuts loses double precision
+// at weights of 1e15 and more, and float weights overflow beyond.
 constexpr double kMaxLambda = 1e6;
 }  // namespace
 
 double OrientationStereoOptions::ViewLambda(double label_step_px) const {
   if (lambda_label_step_px <= 0 || !(label_step_px > 0)) return lambda;
   const double ratio = label_step_px / lambda_label_step_px;
-  // Within lambda's own bound (Check): float smoothness weights overflow beyond.
   return std::min(lambda * ratio * ratio, kMaxLambda);
 }
 
@@ -535,6 +534,48 @@ void RemoveDepthAndNormals(const Workspace& workspace, const std::string& name,
   }
 }
 
+// Warns of the sources whose match the stereo cannot trust, once per view (its first
+// estimate): one that images the hair at another scale, and, with the epipole roll, one whose
+// epipole lies in the reference's image.
+void WarnOfMismatchedSources(const std::string& name, const StereoViewData& ref,
+                             const std::vector<const StereoViewData*>& sources,
+                             const std::vector<std::string>& source_names,
+                             const DepthLabels& labels, const OrientationStereoOptions& options) {
+  // The orientation fields' filters are in pixels: a source that images the hair at another
+  // scale sees other strands' bands, and the match leans behind (measured on a synthesised T
+  // group at 240 px, two sources upsampled to 1.5 / 1.9 / 2 times the reference's scale:
+  // per-pixel median 6.49 / 13.47 / 17.84 mm against 6.21, signed +11 to +15 mm).
+  // synth_handheld's close-up h14, whose sources image the hair at 0.56-0.61 times its scale,
+  // scores 3.73 mm, among its best views: warned beyond 1.85.
+  constexpr double kMaxImageScaleRatio = 1.85;
+  const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
+    if (ratio > 0 && (ratio > kMaxImageScaleRatio || ratio < 1 / kMaxImageScaleRatio)) {
+      LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
+                   << std::setprecision(3) << ratio << " times this view's scale (px per metre at "
+                   << depth_mid
+                   << " m); orientation fields do not match across scales, so that its depths "
+                      "lean behind: give the views one scale (images of one size, "
+                      "--OrientationStereo.max_image_size) or other sources "
+                      "(stereo/patch-match.cfg)";
+    }
+    // Eq. 5's roll is one angle per pair, that of the epipole seen from the principal point:
+    // where the epipole lies in the image (a source ahead or behind), the direction to it, and
+    // so the roll, changes across the image.
+    const Eigen::Vector3d src_center = sources[s]->camera.Center();
+    if (options.orientation_transfer == OrientationTransfer::kEpipoleRoll &&
+        EpipoleInImage(ref.camera, src_center)) {
+      const Eigen::Vector2d e = Epipole(ref.camera, src_center).hnormalized();
+      LOG(WARNING) << name << ": source " << source_names[s] << "'s epipole lies in the image, at ("
+                   << e.x() << ", " << e.y() << ") px, where the epipole roll correction is no "
+                   << "single angle: its orientation cost is wrong there; "
+                      "--OrientationStereo.orientation_transfer plane_homography (the default) "
+                      "carries each orientation itself";
+    }
+  }
+}
+
 }  // namespace
 
 OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
@@ -729,39 +770,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const DepthLabels labels(depth_min, depth_max, options.num_depths,
                              options.depth_sampling == DepthSampling::kInverseDepth);
     if (prior == nullptr) {
-      // The orientation fields' filters are in pixels: a source that images the hair at
-      // another scale sees other strands' bands, and the match leans behind (measured on a
-      // synthesised T group at 240 px, two sources upsampled to 1.5 / 1.9 / 2 times the
-      // reference's scale: per-pixel median 6.49 / 13.47 / 17.84 mm against 6.21, signed +11 to
-      // +15 mm). synth_handheld's close-up h14, whose sources image the hair at 0.56-0.61
-      // times its scale, scores 3.73 mm, among its best views: warned beyond 1.85.
-      constexpr double kMaxImageScaleRatio = 1.85;
-      const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
-      for (size_t s = 0; s < sources.size(); ++s) {
-        const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
-        if (ratio > 0 && (ratio > kMaxImageScaleRatio || ratio < 1 / kMaxImageScaleRatio)) {
-          LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
-                       << std::setprecision(3) << ratio
-                       << " times this view's scale (px per metre at " << depth_mid
-                       << " m); orientation fields do not match across scales, so that its "
-                          "depths lean behind: give the views one scale (images of one size, "
-                          "--OrientationStereo.max_image_size) or other sources "
-                          "(stereo/patch-match.cfg)";
-        }
-        // Eq. 5's roll is one angle per pair, that of the epipole seen from the principal
-        // point: where the epipole lies in the image (a source ahead or behind), the direction
-        // to it, and so the roll, changes across the image.
-        const Eigen::Vector3d src_center = sources[s]->camera.Center();
-        if (options.orientation_transfer == OrientationTransfer::kEpipoleRoll &&
-            EpipoleInImage(ref.camera, src_center)) {
-          const Eigen::Vector2d e = Epipole(ref.camera, src_center).hnormalized();
-          LOG(WARNING) << name << ": source " << source_names[s] << "'s epipole lies in the "
-                       << "image, at (" << e.x() << ", " << e.y() << ") px, where the epipole "
-                       << "roll correction is no single angle: its orientation cost is wrong "
-                          "there; --OrientationStereo.orientation_transfer plane_homography "
-                          "(the default) carries each orientation itself";
-        }
-      }
+      WarnOfMismatchedSources(name, ref, sources, source_names, labels, options);
     }
 
     DepthEstimate estimate = EstimateDepthMap(
