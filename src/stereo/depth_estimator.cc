@@ -274,6 +274,25 @@ int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
   return block;
 }
 
+std::vector<int> SourceLevelOffsets(const StereoViewData& ref,
+                                    const std::vector<const StereoViewData*>& sources,
+                                    const DepthLabels& labels, bool match_scale) {
+  std::vector<int> offsets(sources.size(), 0);
+  if (!match_scale) return offsets;
+  const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
+  for (size_t s = 0; s < sources.size(); ++s) {
+    const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
+    if (ratio > 0) offsets[s] = static_cast<int>(std::lround(std::log2(ratio)));
+  }
+  return offsets;
+}
+
+int SourceLevel(const StereoViewData& source, int level, int offset, bool colour) {
+  int num_levels = static_cast<int>(source.orientation.size());
+  if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(source.rgb.size()));
+  return std::clamp(level + offset, 0, num_levels - 1);
+}
+
 namespace {
 
 // EstimateDepthMap on the reference's whole grid.
@@ -330,26 +349,30 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   const int num_sources = static_cast<int>(sources.size());
   const int num_best_sources = options.NumBestSources(num_sources);
   const bool select_sources = num_best_sources < num_sources;
+  const std::vector<int> source_level_offsets =
+      SourceLevelOffsets(ref, sources, labels, options.match_source_scale);
   {
     ScopedStageTimer timer(timings, "cost volume");
     const std::vector<std::pair<StereoCost, float>> terms = options.DataTerms();
     for (int l = 0; l < num_levels; ++l) {
       for (int term = 0; term < static_cast<int>(terms.size()); ++term) {
         const auto& [cost, weight] = terms[term];
-        auto matched = [cost = cost, l](const StereoViewData& view) -> const FloatMap& {
-          if (cost == StereoCost::kPhotometric) return view.rgb[l];
-          return view.matching.empty() ? view.orientation[l] : view.matching[l];
+        auto matched = [cost = cost](const StereoViewData& view, int level) -> const FloatMap& {
+          if (cost == StereoCost::kPhotometric) return view.rgb[level];
+          return view.matching.empty() ? view.orientation[level] : view.matching[level];
         };
         // Level cameras as the pyramid makes the levels (CostVolumeCL checks their sizes).
-        CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref)};
+        CostViewInput ref_in{ref.camera.PyramidLevel(l), matched(ref, l)};
         if (strand_plane_from_hull && cost == StereoCost::kOrientation) {
           ref_in.log_depth_gradient = LogDepthGradient(
               visual_hull_entry, l, ref_in.field.Width(), ref_in.field.Height(),
               ref.camera.K(0, 0), options.max_strand_plane_tilt_deg);
         }
         std::vector<CostViewInput> src_in;
-        for (const StereoViewData* src : sources) {
-          src_in.push_back({src->camera.PyramidLevel(l), matched(*src)});
+        for (int s = 0; s < num_sources; ++s) {
+          const StereoViewData* src = sources[s];
+          const int src_level = SourceLevel(*src, l, source_level_offsets[s], colour);
+          src_in.push_back({src->camera.PyramidLevel(src_level), matched(*src, src_level)});
           src_in.back().weight = static_cast<float>(options.LevelSourceWeight(
               l, num_levels, ViewingAngleDeg(ref.camera, src->camera)));
         }

@@ -45,6 +45,18 @@ double MeanSquareOfNonZero(const FloatMap& field);
 // are zero).
 FloatMap ScaleToRms(const FloatMap& field, double rms);
 
+// Each source's pyramid level offset against the reference's: round(log2 of the scale at which
+// it images the middle of the depth range, against the reference's; ImageScaleRatio), so that
+// the reference's level l meets the source's level l + offset, where the filter bank's bands
+// in pixels cover the same strands. All 0 unless match_scale.
+std::vector<int> SourceLevelOffsets(const StereoViewData& ref,
+                                    const std::vector<const StereoViewData*>& sources,
+                                    const DepthLabels& labels, bool match_scale);
+
+// The source's pyramid level that the reference's `level` meets: level + offset, clamped to
+// the levels the source has (of its orientation fields, and of its colour images if `colour`).
+int SourceLevel(const StereoViewData& source, int level, int offset, bool colour);
+
 struct DepthEstimate {
   FloatMap depth;       // z-depth on the level-0 grid, 0 = invalid
   FloatMap confidence;  // aggregated cost margin (second-best minus best), level-0 grid

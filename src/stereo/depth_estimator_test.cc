@@ -715,6 +715,77 @@ TEST(DepthEstimator, OrientationTransferIsNeededForARolledSource) {
               without.median_abs_error_m);
 }
 
+// A source imaging the plane at s times the reference's scale meets the reference's level l
+// at its level l + round(log2 s), clamped to the levels it has.
+TEST(DepthEstimator, SourceLevelsFollowTheScaleAtWhichTheyImage) {
+  const Eigen::Vector3d target(0, 0, 1);
+  auto view = [&](double focal_px, int levels) {
+    StereoViewData data;
+    data.camera = LookAtCamera({0.1, 0, 0}, target, focal_px, 96, 72);
+    data.orientation.assign(levels, FloatMap(1, 1, 2));
+    return data;
+  };
+  const StereoViewData ref = view(100, 3);
+  const std::vector<StereoViewData> others = {view(100, 3), view(130, 3), view(150, 3),
+                                              view(200, 3), view(50, 3),  view(800, 3)};
+  std::vector<const StereoViewData*> sources;
+  for (const StereoViewData& v : others) sources.push_back(&v);
+  const DepthLabels labels(0.9, 1.1, 16, true);
+  EXPECT_EQ(SourceLevelOffsets(ref, sources, labels, true),
+            std::vector<int>({0, 0, 1, 1, -1, 3}));
+  EXPECT_EQ(SourceLevelOffsets(ref, sources, labels, false), std::vector<int>(6, 0));
+  EXPECT_EQ(SourceLevel(others[3], 0, 1, false), 1);
+  EXPECT_EQ(SourceLevel(others[3], 2, 1, false), 2);   // no level 3
+  EXPECT_EQ(SourceLevel(others[4], 0, -1, false), 0);  // no level -1
+  EXPECT_EQ(SourceLevel(others[4], 2, -1, false), 1);
+  StereoViewData fewer_colours = view(200, 3);
+  fewer_colours.rgb.assign(2, FloatMap(1, 1, 3));
+  EXPECT_EQ(SourceLevel(fewer_colours, 1, 1, true), 1);  // the colour pyramid's last level
+  EXPECT_EQ(SourceLevel(fewer_colours, 1, 1, false), 2);
+}
+
+// Sources imaging the plane at twice the reference's scale (twice its focal length and size)
+// whose level 1 holds the field at the reference's scale and whose level 0 is noise: matched a
+// level finer (match_source_scale), the reference meets only the true fields and recovers the
+// plane; level for level, its finest level meets the noise.
+TEST(DepthEstimator, SourcesAtTwiceTheScaleAreMatchedALevelFiner) {
+  Surface plane;
+  plane.point = {0, 0, 1};
+  plane.normal = Eigen::Vector3d(std::sin(0.35), 0, -std::cos(0.35));
+  const auto strands = MakeStrands(plane, 900, 0.6, 0.25, 1);
+  const Eigen::Vector3d target(0, 0, 1);
+  const testing_util::RenderedView ref =
+      RenderView(LookAtCamera({0, 0, 0}, target, 100, 96, 72), plane, strands);
+  std::vector<StereoViewData> views = {{ref.camera, Pyramid(ref.orientation, 3), {}, {}}};
+  unsigned seed = 1;
+  for (const Eigen::Vector3d& center :
+       {Eigen::Vector3d(0.3, 0, 0), Eigen::Vector3d(-0.3, 0, 0), Eigen::Vector3d(0, -0.3, 0)}) {
+    const StereoCamera big = LookAtCamera(center, target, 200, 192, 144);
+    const std::vector<FloatMap> fine =
+        Pyramid(RenderView(big.PyramidLevel(1), plane, strands).orientation, 2);
+    views.push_back({big, {testing_util::RandomMap(192, 144, 2, seed++), fine[0], fine[1]}, {}, {}});
+  }
+  const std::vector<const StereoViewData*> sources = {&views[1], &views[2], &views[3]};
+  auto context = OpenCLContext::Create();
+  OrientationStereoOptions options = TestOptions();
+  const DepthLabels labels(0.7, 1.5, options.num_depths, true);
+  auto median_error = [&](const OrientationStereoOptions& o) {
+    const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
+                                                    FloatMap(), labels, o, nullptr);
+    size_t count = 0;
+    const double error = MedianAbsError(estimate.depth, ref.depth, &count);
+    EXPECT_GT(count, ref.depth.NumPixels() / 2);
+    return error;
+  };
+  const double matched = median_error(options);
+  options.match_source_scale = false;
+  const double level_for_level = median_error(options);
+  std::printf("sources at twice the scale: median |error| %.4f m matched, %.4f m level for "
+              "level\n", matched, level_for_level);
+  EXPECT_LT(matched, 0.01);
+  EXPECT_GT(level_for_level, 3 * matched);
+}
+
 }  // namespace
 }  // namespace hairmvs
 

@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iomanip>
+#include <limits>
 #include <list>
 #include <map>
 #include <memory>
@@ -535,30 +536,49 @@ void RemoveDepthAndNormals(const Workspace& workspace, const std::string& name,
 }
 
 // Warns of the sources whose match the stereo cannot trust, once per view (its first
-// estimate): one that images the hair at another scale, and, with the epipole roll, one whose
-// epipole lies in the reference's image.
+// estimate): one that images the hair at a scale that no pyramid level matches, and, with the
+// epipole roll, one whose epipole lies in the reference's image. Says which sources are
+// matched at another level (match_source_scale).
 void WarnOfMismatchedSources(const std::string& name, const StereoViewData& ref,
                              const std::vector<const StereoViewData*>& sources,
                              const std::vector<std::string>& source_names,
                              const DepthLabels& labels, const OrientationStereoOptions& options) {
   // The orientation fields' filters are in pixels: a source that images the hair at another
-  // scale sees other strands' bands, and the match leans behind (measured on a synthesised T
-  // group at 240 px, two sources upsampled to 1.5 / 1.9 / 2 times the reference's scale:
-  // per-pixel median 6.49 / 13.47 / 17.84 mm against 6.21, signed +11 to +15 mm).
-  // synth_handheld's close-up h14, whose sources image the hair at 0.56-0.61 times its scale,
-  // scores 3.73 mm, among its best views: warned beyond 1.85.
+  // scale sees other strands' bands at the same level, and the match leans behind. Measured on
+  // a synthesised T group at 480 px whose side views were rendered at 960 px (twice the scale),
+  // level l meeting level l: g0_c and g0_b per-pixel median 3.71 mm against 3.49 with all four
+  // at 480 px, g0_l and g0_r 3.68 against 2.76 with all four at 960 px. Matched a level apart:
+  // 2.94 and 2.72 mm. A level matches within a factor sqrt(2); a source farther off than
+  // kMaxImageScaleRatio at every level is warned of.
   constexpr double kMaxImageScaleRatio = 1.85;
   const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
+  const std::vector<int> offsets =
+      SourceLevelOffsets(ref, sources, labels, options.match_source_scale);
+  const bool colour = options.MatchesColour();
   for (size_t s = 0; s < sources.size(); ++s) {
     const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
-    if (ratio > 0 && (ratio > kMaxImageScaleRatio || ratio < 1 / kMaxImageScaleRatio)) {
-      LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
-                   << std::setprecision(3) << ratio << " times this view's scale (px per metre at "
-                   << depth_mid
-                   << " m); orientation fields do not match across scales, so that its depths "
-                      "lean behind: give the views one scale (images of one size, "
-                      "--OrientationStereo.max_image_size) or other sources "
-                      "(stereo/patch-match.cfg)";
+    if (ratio > 0) {
+      double best = std::numeric_limits<double>::infinity();  // the closest level's mismatch
+      for (int l = 0; l < options.num_levels; ++l) {
+        const int src_level = SourceLevel(*sources[s], l, offsets[s], colour);
+        const double residual = ratio / std::ldexp(1.0, src_level - l);
+        best = std::min(best, std::max(residual, 1 / residual));
+      }
+      if (best > kMaxImageScaleRatio) {
+        LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
+                     << std::setprecision(3) << ratio
+                     << " times this view's scale (px per metre at " << depth_mid
+                     << " m), which no pyramid level of its orientation fields matches, so that "
+                        "its depths lean behind: give the views closer scales (images of one "
+                        "size, --OrientationStereo.max_image_size"
+                     << (options.match_source_scale ? ""
+                                                    : "; --OrientationStereo.match_source_scale 1")
+                     << ") or other sources (stereo/patch-match.cfg)";
+      } else if (offsets[s] != 0) {
+        LOG(INFO) << name << ": source " << source_names[s] << " images the hair at "
+                  << std::setprecision(3) << ratio << " times this view's scale: level l meets "
+                  << "its level l " << (offsets[s] > 0 ? "+ " : "- ") << std::abs(offsets[s]);
+      }
     }
     // Eq. 5's roll is one angle per pair, that of the epipole seen from the principal point:
     // where the epipole lies in the image (a source ahead or behind), the direction to it, and
