@@ -165,7 +165,8 @@ struct OrientationStereoOptions {
   // Measured on a synthesised 480 px T group whose side views were rendered at 960 px: the 480
   // px views' per-pixel median 2.94 mm matched, 3.71 level for level (3.49 with every view at
   // 480 px), the 960 px views' 2.72 against 3.68 mm (2.76 with every view at 960 px); see the
-  // README for synth_handheld.
+  // README for synth_handheld. A source dropped at the levels where its matching level is
+  // clamped (a prototype, not kept): 3.00 and 2.84 mm.
   bool match_source_scale = true;
   // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
   // level 0 (finest), 1, 2. 15/11/7 measured better than 7/11/15 on synth_straight_gantry g0_c
