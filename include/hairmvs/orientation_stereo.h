@@ -159,14 +159,11 @@ struct OrientationStereoOptions {
   double level0_weight_angle_deg = 20;
   double level0_weight_angle_power = 2;
   // Match each source's pyramid level to the scale at which it images the hair: the reference's
-  // level l meets the source's level l + round(log2(ratio)) (SourceLevelOffsets), clamped to
+  // level l meets the source's level l + round(log2(ratio)) (SourceLevelOffset), clamped to
   // the source's levels. The filter bank's bands are in pixels, so a source imaging the hair at
   // twice the scale sees other strands' bands at the same level. 0: level l meets level l.
-  // Measured on a synthesised 480 px T group whose side views were rendered at 960 px: the 480
-  // px views' per-pixel median 2.94 mm matched, 3.71 level for level (3.49 with every view at
-  // 480 px), the 960 px views' 2.72 against 3.68 mm (2.76 with every view at 960 px); see the
-  // README for synth_handheld. A source dropped at the levels where its matching level is
-  // clamped (a prototype, not kept): 3.00 and 2.84 mm.
+  // Measured in the README (a T group of mixed sizes, synth_handheld). A source dropped at the
+  // levels where its matching level is clamped (a prototype, not kept) did worse there.
   bool match_source_scale = true;
   // Guided-filter windows (paper: 7, 11, 15 px; it does not say which level gets which) per
   // level 0 (finest), 1, 2. 15/11/7 measured better than 7/11/15 on synth_straight_gantry g0_c

@@ -274,23 +274,30 @@ int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
   return block;
 }
 
-std::vector<int> SourceLevelOffsets(const StereoViewData& ref,
-                                    const std::vector<const StereoViewData*>& sources,
-                                    const DepthLabels& labels, bool match_scale) {
-  std::vector<int> offsets(sources.size(), 0);
-  if (!match_scale) return offsets;
-  const double depth_mid = labels.Depth(0.5 * (labels.num_labels - 1));
-  for (size_t s = 0; s < sources.size(); ++s) {
-    const double ratio = ImageScaleRatio(ref.camera, sources[s]->camera, depth_mid);
-    if (ratio > 0) offsets[s] = static_cast<int>(std::lround(std::log2(ratio)));
-  }
-  return offsets;
+double SourceScaleRatio(const StereoViewData& ref, const StereoViewData& source,
+                        const DepthLabels& labels) {
+  return ImageScaleRatio(ref.camera, source.camera, labels.Depth(0.5 * (labels.num_labels - 1)));
+}
+
+int SourceLevelOffset(double ratio, bool match_scale) {
+  return match_scale && ratio > 0 ? static_cast<int>(std::lround(std::log2(ratio))) : 0;
 }
 
 int SourceLevel(const StereoViewData& source, int level, int offset, bool colour) {
   int num_levels = static_cast<int>(source.orientation.size());
   if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(source.rgb.size()));
   return std::clamp(level + offset, 0, num_levels - 1);
+}
+
+double BestLevelScaleMismatch(const StereoViewData& source, double ratio, int offset,
+                              bool colour, int num_levels) {
+  if (!(ratio > 0)) return 0;
+  double best = std::numeric_limits<double>::infinity();
+  for (int l = 0; l < num_levels; ++l) {
+    const double r = ratio / std::ldexp(1.0, SourceLevel(source, l, offset, colour) - l);
+    best = std::min(best, std::max(r, 1 / r));
+  }
+  return best;
 }
 
 namespace {
@@ -349,8 +356,11 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   const int num_sources = static_cast<int>(sources.size());
   const int num_best_sources = options.NumBestSources(num_sources);
   const bool select_sources = num_best_sources < num_sources;
-  const std::vector<int> source_level_offsets =
-      SourceLevelOffsets(ref, sources, labels, options.match_source_scale);
+  std::vector<int> source_level_offsets;
+  for (const StereoViewData* src : sources) {
+    source_level_offsets.push_back(
+        SourceLevelOffset(SourceScaleRatio(ref, *src, labels), options.match_source_scale));
+  }
   {
     ScopedStageTimer timer(timings, "cost volume");
     const std::vector<std::pair<StereoCost, float>> terms = options.DataTerms();

@@ -45,17 +45,26 @@ double MeanSquareOfNonZero(const FloatMap& field);
 // are zero).
 FloatMap ScaleToRms(const FloatMap& field, double rms);
 
-// Each source's pyramid level offset against the reference's: round(log2 of the scale at which
-// it images the middle of the depth range, against the reference's; ImageScaleRatio), so that
-// the reference's level l meets the source's level l + offset, where the filter bank's bands
-// in pixels cover the same strands. All 0 unless match_scale.
-std::vector<int> SourceLevelOffsets(const StereoViewData& ref,
-                                    const std::vector<const StereoViewData*>& sources,
-                                    const DepthLabels& labels, bool match_scale);
+// The scale at which `source` images the point of the reference's centre ray at the depth
+// range's middle label, against the reference's (ImageScaleRatio; 0 where it lies behind it).
+double SourceScaleRatio(const StereoViewData& ref, const StereoViewData& source,
+                        const DepthLabels& labels);
+
+// The offset from the reference's pyramid level to the source's level that images the hair at
+// its scale, for a source at `ratio` (SourceScaleRatio): round(log2 ratio), so that the
+// filter bank's bands in pixels cover the same strands. 0 unless match_scale and ratio > 0.
+int SourceLevelOffset(double ratio, bool match_scale);
 
 // The source's pyramid level that the reference's `level` meets: level + offset, clamped to
 // the levels the source has (of its orientation fields, and of its colour images if `colour`).
 int SourceLevel(const StereoViewData& source, int level, int offset, bool colour);
+
+// How far off the reference's scale the best-matched of the source's levels that the
+// reference's first num_levels levels meet images the hair: the least over those levels l of
+// max(r, 1 / r), r = ratio / 2^(SourceLevel(source, l, offset, colour) - l), `ratio` from
+// SourceScaleRatio; 0 where ratio <= 0.
+double BestLevelScaleMismatch(const StereoViewData& source, double ratio, int offset,
+                              bool colour, int num_levels);
 
 struct DepthEstimate {
   FloatMap depth;       // z-depth on the level-0 grid, 0 = invalid

@@ -114,7 +114,8 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
 bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,
-                          double* max_m, const VisualHullRangeOptions& options) {
+                          double* max_m, const VisualHullRangeOptions& options,
+                          bool* near_end_at_search_start) {
   VisualHullRangeOptions with_far_ends = options;
   with_far_ends.find_far_ends = true;
   const FloatMap intervals =
@@ -135,29 +136,72 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
   };
   const double lo = percentile(&near_ends, options.low_percentile);
   const double hi = percentile(&far_ends, options.high_percentile);
+  if (near_end_at_search_start != nullptr) {
+    // A ray inside the hull at the first sample has its near end there (up to float rounding).
+    *near_end_at_search_start = lo <= search_min_m * (1 + 1e-6);
+  }
   const double margin = std::max(options.margin_fraction * (hi - lo), options.margin_m);
   *min_m = std::max(lo - margin, search_min_m);
   *max_m = std::min(hi + margin, search_max_m);
   return *max_m > *min_m;
 }
 
+namespace {
+
+// Above this mean fraction of their pixels kept by the other views' masks, a hull reaching the
+// search's start is not searched nearer.
+constexpr double kMaxKeptFractionToSearchNearer = 0.5;
+
+// The mean over the views of the fraction of their pixels their masks keep (> 0.5).
+double KeptFraction(const std::vector<std::pair<StereoCamera, FloatMap>>& views) {
+  double sum = 0;
+  for (const auto& [camera, mask] : views) {
+    const size_t kept = std::count_if(mask.Data().begin(), mask.Data().end(),
+                                      [](float v) { return v > 0.5f; });
+    sum += mask.NumPixels() > 0 ? static_cast<double>(kept) / mask.NumPixels() : 0;
+  }
+  return views.empty() ? 0 : sum / views.size();
+}
+
+}  // namespace
+
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              const DepthRange& all_points, const DepthRange& in_mask,
                              double* min_m, double* max_m, bool* narrowed,
-                             const VisualHullRangeOptions& options) {
+                             bool* searched_nearer, const VisualHullRangeOptions& options) {
   double search_min = all_points.min_m, search_max = all_points.max_m;
   if (in_mask.inside_mask) {
     search_min = std::min(search_min, in_mask.min_m);
     search_max = std::max(search_max, in_mask.max_m);
   }
+  if (!(search_min > 0 && search_max > search_min)) return false;
+  // Each try searches 4 times nearer than the last, the first from half the points' near end;
+  // only when the masks carve: those keeping most of their images (none drawn) leave a hull
+  // that the views' frusta end near the cameras, which the points bound better.
+  const int num_tries = KeptFraction(others) <= kMaxKeptFractionToSearchNearer ? 4 : 1;
+  constexpr double kNearerFactor = 4;
   double hull_min = 0, hull_max = 0;
-  if (!(search_min > 0 && search_max > search_min) ||
-      !VisualHullDepthRange(ref, ref_mask, others, 0.5 * search_min, 2 * search_max, &hull_min,
-                            &hull_max, options)) {
-    return false;
+  bool found = false;
+  for (int attempt = 0; attempt < num_tries; ++attempt) {
+    const double start = 0.5 * search_min / std::pow(kNearerFactor, attempt);
+    double try_min = 0, try_max = 0;
+    bool at_start = false;
+    if (!VisualHullDepthRange(ref, ref_mask, others, start, 2 * search_max, &try_min, &try_max,
+                              options, &at_start)) {
+      continue;
+    }
+    if (!found || !at_start) {
+      hull_min = try_min;
+      hull_max = try_max;
+      *searched_nearer = attempt > 0;
+    }
+    found = true;
+    if (!at_start) break;
   }
-  *narrowed = in_mask.inside_mask && in_mask.min_m >= hull_min && in_mask.max_m <= hull_max;
+  if (!found) return false;
+  *narrowed = !*searched_nearer && in_mask.inside_mask && in_mask.min_m >= hull_min &&
+              in_mask.max_m <= hull_max;
   *min_m = *narrowed ? in_mask.min_m : hull_min;
   *max_m = *narrowed ? in_mask.max_m : hull_max;
   return true;

@@ -59,12 +59,15 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
 // Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
 // pixel convention. The range spans the percentiles of the near ends (low) and far ends (high)
 // of VisualHullIntervals (with far ends), sampled every options.pixel_step pixels. Returns false
-// (outputs untouched) when too few rays enter the hull.
+// (outputs untouched) when too few rays enter the hull. *near_end_at_search_start (if given):
+// the low percentile of the near ends is the search's start, so that the hull may go on in
+// front of it.
 bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,
                           double* max_m,
-                          const VisualHullRangeOptions& options = VisualHullRangeOptions());
+                          const VisualHullRangeOptions& options = VisualHullRangeOptions(),
+                          bool* near_end_at_search_start = nullptr);
 
 // A view's depth range from its masks' visual hull and COLMAP's ranges of its sparse points:
 // the hull searched over [0.5 x, 2 x] the span of `all_points` and `in_mask` (the points
@@ -74,11 +77,18 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
 // the points: 3.4 x finer labels). Points that reach out of the hull disagree with the masks
 // and are left out: hair is hard to match, and neither range need cover it (synth_handheld
 // h02: its hair at 0.35-0.62 m, its points in the mask 0.69 m away and more, COLMAP's range of
-// all its points from 1.14 m). Returns false (outputs untouched) when the hull gives no range.
+// all its points from 1.14 m). When the hull reaches the search's start, or no ray meets it
+// there, every point may lie behind the head (on the room only: a head without sparse points),
+// and the search starts 4, 16 and then 64 times nearer until the hull's near end lies inside
+// it (*searched_nearer = true; the points do not narrow such a range), unless the other
+// views' masks keep more than half their pixels (masks drawn loosely or not at all carve
+// nothing near the views); a hull that still reaches the start is taken as first found.
+// Returns false (outputs untouched) when the hull gives no range.
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              const DepthRange& all_points, const DepthRange& in_mask,
                              double* min_m, double* max_m, bool* narrowed,
+                             bool* searched_nearer,
                              const VisualHullRangeOptions& options = VisualHullRangeOptions());
 
 }  // namespace hairmvs

@@ -194,27 +194,66 @@ TEST(DepthRangeTest, HullAndPointsRangeKeepsTheHullWhenThePointsDisagree) {
   EXPECT_GE(min_m, 1.0);
   // The points in the mask are wrong too (behind the sphere and beyond), but nearer than the
   // room's: the hull is searched from half their near end and kept as it is.
-  bool narrowed = true;
+  bool narrowed = true, nearer = true;
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
-                                      Points(0.7, 3.0, true), &min_m, &max_m, &narrowed));
+                                      Points(0.7, 3.0, true), &min_m, &max_m, &narrowed,
+                                      &nearer));
   EXPECT_FALSE(narrowed);
+  EXPECT_FALSE(nearer);
   EXPECT_LT(min_m, 0.9);
   EXPECT_GT(max_m, 1.1);
   EXPECT_LT(max_m - min_m, 0.5);
   // Points in the mask whose range lies within the hull's narrow it (a long T-group hull).
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
-                                      Points(0.92, 1.08, true), &min_m, &max_m, &narrowed));
+                                      Points(0.92, 1.08, true), &min_m, &max_m, &narrowed,
+                                      &nearer));
   EXPECT_TRUE(narrowed);
+  EXPECT_FALSE(nearer);
   EXPECT_EQ(min_m, 0.92);
   EXPECT_EQ(max_m, 1.08);
   // Not from the mask (COLMAP's fallback to all points): never narrows.
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(0.6, 3.0, false),
-                                      Points(0.92, 1.08, false), &min_m, &max_m, &narrowed));
+                                      Points(0.92, 1.08, false), &min_m, &max_m, &narrowed,
+                                      &nearer));
   EXPECT_FALSE(narrowed);
   EXPECT_LT(min_m, 0.9);
   // No points at all: no range.
   EXPECT_FALSE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(-1, -1, false),
-                                       Points(-1, -1, false), &min_m, &max_m, &narrowed));
+                                       Points(-1, -1, false), &min_m, &max_m, &narrowed,
+                                       &nearer));
+}
+
+// Every point behind the sphere (on a room behind the head, say): searched from half their
+// near end, the hull reaches the search's start, so it is searched again nearer; points that
+// lie within the hull found so do not narrow it.
+TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHull) {
+  const Scene scene = MakeScene(7);
+  const FloatMap mask = SphereMask(scene.ref);
+  double min_m = 0, max_m = 0;
+  bool narrowed = true, nearer = false;
+  for (const DepthRange& in_mask : {Points(-1, -1, false), Points(2.5, 4.0, true)}) {
+    ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(2.5, 5.0, false),
+                                        in_mask, &min_m, &max_m, &narrowed, &nearer));
+    EXPECT_TRUE(nearer);
+    EXPECT_FALSE(narrowed);
+    EXPECT_LT(min_m, 0.9);
+    EXPECT_GT(min_m, 0.8);
+    EXPECT_GT(max_m, 1.05);
+    EXPECT_LT(max_m, 1.3);
+  }
+  // Masks that keep whole images carve nothing: the first search's range stands (searched
+  // nearer, the hull would run up to the frusta's meeting near the views).
+  Scene unmasked = MakeScene(7);
+  for (auto& view : unmasked.others) view.second = FloatMap(160, 120, 1, 1.0f);
+  double first_min = 0, first_max = 0;
+  ASSERT_TRUE(VisualHullDepthRange(unmasked.ref, mask, unmasked.others, 1.25, 10.0, &first_min,
+                                   &first_max));
+  ASSERT_TRUE(HullAndPointsDepthRange(unmasked.ref, mask, unmasked.others,
+                                      Points(2.5, 5.0, false), Points(-1, -1, false), &min_m,
+                                      &max_m, &narrowed, &nearer));
+  EXPECT_FALSE(nearer);
+  EXPECT_EQ(min_m, first_min);
+  EXPECT_EQ(max_m, first_max);
 }
 
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {
