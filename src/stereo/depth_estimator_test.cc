@@ -786,7 +786,8 @@ TEST(DepthEstimator, SourcesAtTwiceTheScaleAreMatchedAtTheirNextCoarserLevel) {
     const StereoCamera big = LookAtCamera(center, target, 200, 192, 144);
     const std::vector<FloatMap> fine =
         Pyramid(RenderView(big.PyramidLevel(1), plane, strands).orientation, 2);
-    views.push_back({big, {testing_util::RandomMap(192, 144, 2, seed++), fine[0], fine[1]}, {}, {}});
+    const FloatMap noise = testing_util::RandomMap(192, 144, 2, seed++);
+    views.push_back({big, {noise, fine[0], fine[1]}, {}, {}});
   }
   const std::vector<const StereoViewData*> sources = {&views[1], &views[2], &views[3]};
   auto context = OpenCLContext::Create();
