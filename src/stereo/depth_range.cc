@@ -19,11 +19,14 @@ struct Projection {
   const FloatMap* mask;
 };
 
-// Whether the point X (reference camera frame) is inside the hull: seen inside the image by at
-// least `min_observing` views, and outside the mask of fewer than `min_carving` of them (all of
-// them, when fewer see it).
-bool InsideHull(const std::vector<Projection>& projections, int min_observing, int min_carving,
-                const Eigen::Vector3d& X) {
+enum class HullSample { kInside, kCarved, kUnobserved };
+
+// Where the point X (reference camera frame) lies: inside the hull (seen inside the image by at
+// least `min_observing` views, and outside the mask of fewer than `min_carving` of them, all of
+// them when fewer see it), carved (outside enough of the masks of the views that see it), or
+// unobserved (seen by too few views, whatever their masks say).
+HullSample ClassifyHullSample(const std::vector<Projection>& projections, int min_observing,
+                              int min_carving, const Eigen::Vector3d& X) {
   int observing = 0, carving = 0;
   for (const Projection& p : projections) {
     const Eigen::Vector3d u = p.A * X + p.c;
@@ -33,10 +36,11 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing, i
     ++observing;
     const int c = std::min(static_cast<int>(x), p.camera->width - 1);
     const int r = std::min(static_cast<int>(y), p.camera->height - 1);
-    if (!(p.mask->At(r, c) > 0.5f) && ++carving >= min_carving) return false;
+    if (!(p.mask->At(r, c) > 0.5f) && ++carving >= min_carving) return HullSample::kCarved;
   }
-  return observing >= std::max(1, min_observing) &&
-         carving < std::max(1, std::min(min_carving, observing));
+  if (observing < std::max(1, min_observing)) return HullSample::kUnobserved;
+  return carving < std::max(1, std::min(min_carving, observing)) ? HullSample::kInside
+                                                                  : HullSample::kCarved;
 }
 
 }  // namespace
@@ -44,7 +48,7 @@ bool InsideHull(const std::vector<Projection>& projections, int min_observing, i
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              double search_min_m, double search_max_m,
-                             const VisualHullRangeOptions& options) {
+                             const VisualHullRangeOptions& options, FloatMap* masks_cut_near_end) {
   const int pixel_step = options.pixel_step;
   const bool find_far_ends = options.find_far_ends;
   CHECK_EQ(ref_mask.Width(), ref.width);
@@ -52,6 +56,7 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
   CHECK_GT(pixel_step, 0);
   CHECK_GE(options.num_samples, 2);
   FloatMap intervals(ref.width, ref.height, 2, 0.0f);
+  if (masks_cut_near_end != nullptr) *masks_cut_near_end = FloatMap(ref.width, ref.height, 1);
   if (!(search_min_m > 0 && search_max_m > search_min_m)) return intervals;
   std::vector<Projection> projections;
   for (const auto& [camera, mask] : others) {
@@ -76,15 +81,20 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
       // SfM convention: pixel (col, row) is centred at image point (col + 0.5, row + 0.5).
       const Eigen::Vector3d ray = K_inv * Eigen::Vector3d(col + 0.5, row + 0.5, 1.0);
       // z-depth: the ray has z = 1.
-      auto inside = [&](double k) {
-        return InsideHull(projections, min_observing, options.min_carving_views,
-                          ray / inverse_depth(k));
+      auto classify = [&](double k) {
+        return ClassifyHullSample(projections, min_observing, options.min_carving_views,
+                                  ray / inverse_depth(k));
       };
+      auto inside = [&](double k) { return classify(k) == HullSample::kInside; };
       int entry = -1;
       for (int k = 0; k < n && entry < 0; ++k) {
         if (inside(k)) entry = k;
       }
       if (entry < 0) continue;
+      if (masks_cut_near_end != nullptr && entry > 0 &&
+          classify(entry - 1) == HullSample::kCarved) {
+        masks_cut_near_end->At(row, col) = 1.0f;
+      }
       int exit = n;  // first sample outside after the entry
       for (int k = entry + 1; find_far_ends && k < n; ++k) {
         if (!inside(k)) {
@@ -115,16 +125,24 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,
                           double* max_m, const VisualHullRangeOptions& options,
-                          bool* near_end_at_search_start) {
+                          HullNearEnd* near_end) {
   VisualHullRangeOptions with_far_ends = options;
   with_far_ends.find_far_ends = true;
-  const FloatMap intervals =
-      VisualHullIntervals(ref, ref_mask, others, search_min_m, search_max_m, with_far_ends);
+  FloatMap masks_cut;
+  const FloatMap intervals = VisualHullIntervals(ref, ref_mask, others, search_min_m,
+                                                 search_max_m, with_far_ends, &masks_cut);
   std::vector<double> near_ends, far_ends;
+  int num_cut = 0, num_inside_search = 0;
   for (size_t i = 0; i < intervals.NumPixels(); ++i) {
     if (intervals.Channel(0)[i] > 0) {
       near_ends.push_back(intervals.Channel(0)[i]);
       far_ends.push_back(intervals.Channel(1)[i]);
+      // A ray inside the hull at the first sample has its near end there (up to float
+      // rounding, 6e-8 relative; the first bisection step lies 1e-5 further).
+      if (intervals.Channel(0)[i] > search_min_m * (1 + 1e-6)) {
+        ++num_inside_search;
+        num_cut += masks_cut.Channel(0)[i] > 0;
+      }
     }
   }
   if (static_cast<int>(near_ends.size()) < std::max(1, options.min_rays_in_hull)) return false;
@@ -136,34 +154,16 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
   };
   const double lo = percentile(&near_ends, options.low_percentile);
   const double hi = percentile(&far_ends, options.high_percentile);
-  if (near_end_at_search_start != nullptr) {
-    // A ray inside the hull at the first sample has its near end there (up to float rounding).
-    *near_end_at_search_start = lo <= search_min_m * (1 + 1e-6);
+  if (near_end != nullptr) {
+    near_end->at_search_start = lo <= search_min_m * (1 + 1e-6);
+    near_end->masks_cut_fraction =
+        num_inside_search > 0 ? static_cast<double>(num_cut) / num_inside_search : 0;
   }
   const double margin = std::max(options.margin_fraction * (hi - lo), options.margin_m);
   *min_m = std::max(lo - margin, search_min_m);
   *max_m = std::min(hi + margin, search_max_m);
   return *max_m > *min_m;
 }
-
-namespace {
-
-// Above this mean fraction of their pixels kept by the other views' masks, a hull reaching the
-// search's start is not searched nearer.
-constexpr double kMaxKeptFractionToSearchNearer = 0.5;
-
-// The mean over the views of the fraction of their pixels their masks keep (> 0.5).
-double KeptFraction(const std::vector<std::pair<StereoCamera, FloatMap>>& views) {
-  double sum = 0;
-  for (const auto& [camera, mask] : views) {
-    const size_t kept = std::count_if(mask.Data().begin(), mask.Data().end(),
-                                      [](float v) { return v > 0.5f; });
-    sum += mask.NumPixels() > 0 ? static_cast<double>(kept) / mask.NumPixels() : 0;
-  }
-  return views.empty() ? 0 : sum / views.size();
-}
-
-}  // namespace
 
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
@@ -176,28 +176,37 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
     search_max = std::max(search_max, in_mask.max_m);
   }
   if (!(search_min > 0 && search_max > search_min)) return false;
-  // Each try searches 4 times nearer than the last, the first from half the points' near end;
-  // only when the masks carve: those keeping most of their images (none drawn) leave a hull
-  // that the views' frusta end near the cameras, which the points bound better.
-  const int num_tries = KeptFraction(others) <= kMaxKeptFractionToSearchNearer ? 4 : 1;
+  // Each try searches 4 times nearer than the last, the first from half the points' near end.
+  // A nearer try counts only where the masks, not the views' frusta, cut the hull's near end:
+  // masks that carve nothing near the cameras (drawn loosely, or a close-up whose head fills
+  // the frames) leave a hull that runs up to where the frusta meet, which the points bound
+  // better.
+  constexpr int kNumTries = 4;
   constexpr double kNearerFactor = 4;
+  constexpr double kMinMasksCutFraction = 0.5;
   double hull_min = 0, hull_max = 0;
   bool found = false;
-  for (int attempt = 0; attempt < num_tries; ++attempt) {
+  for (int attempt = 0; attempt < kNumTries; ++attempt) {
     const double start = 0.5 * search_min / std::pow(kNearerFactor, attempt);
     double try_min = 0, try_max = 0;
-    bool at_start = false;
+    HullNearEnd near_end;
     if (!VisualHullDepthRange(ref, ref_mask, others, start, 2 * search_max, &try_min, &try_max,
-                              options, &at_start)) {
+                              options, &near_end)) {
       continue;
     }
-    if (!found || !at_start) {
+    const bool cut_by_masks =
+        !near_end.at_search_start && near_end.masks_cut_fraction >= kMinMasksCutFraction;
+    if (attempt == 0 || cut_by_masks) {
       hull_min = try_min;
       hull_max = try_max;
       *searched_nearer = attempt > 0;
+      found = true;
     }
-    found = true;
-    if (!at_start) break;
+    // Points in the mask within the first search's hull are on the head (a close-up's frusta
+    // meet in front of them, so that its hull reaches the start): no nearer search.
+    const bool points_in_hull = attempt == 0 && in_mask.inside_mask &&
+                                in_mask.max_m >= try_min && in_mask.min_m <= try_max;
+    if (!near_end.at_search_start || points_in_hull) break;
   }
   if (!found) return false;
   *narrowed = !*searched_nearer && in_mask.inside_mask && in_mask.min_m >= hull_min &&

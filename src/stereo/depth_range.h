@@ -50,24 +50,36 @@ struct VisualHullRangeOptions {
 // lies inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
 // phantom stretch of hull, carved by no view, may lie in front of the surface.) The ends are
 // refined by bisection between the depth samples; the far ends only with
-// options.find_far_ends.
+// options.find_far_ends. *masks_cut_near_end (if given): 1 at the sampled pixels whose ray
+// enters the hull after the search's start where a mask carved the sample in front (0 where
+// the views' frusta did: too few views saw it).
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              double search_min_m, double search_max_m,
-                             const VisualHullRangeOptions& options = VisualHullRangeOptions());
+                             const VisualHullRangeOptions& options = VisualHullRangeOptions(),
+                             FloatMap* masks_cut_near_end = nullptr);
+
+// Where VisualHullDepthRange's hull begins.
+struct HullNearEnd {
+  // The low percentile of the rays' near ends is the search's start: the hull may go on in
+  // front of it.
+  bool at_search_start = false;
+  // Of the rays entering the hull after the search's start, the fraction where a mask cut the
+  // near end (masks_cut_near_end).
+  double masks_cut_fraction = 0;
+};
 
 // Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
 // pixel convention. The range spans the percentiles of the near ends (low) and far ends (high)
 // of VisualHullIntervals (with far ends), sampled every options.pixel_step pixels. Returns false
-// (outputs untouched) when too few rays enter the hull. *near_end_at_search_start (if given):
-// the low percentile of the near ends is the search's start, so that the hull may go on in
-// front of it.
+// (outputs untouched) when too few rays enter the hull; *near_end (if given) says where it
+// begins.
 bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                           double search_min_m, double search_max_m, double* min_m,
                           double* max_m,
                           const VisualHullRangeOptions& options = VisualHullRangeOptions(),
-                          bool* near_end_at_search_start = nullptr);
+                          HullNearEnd* near_end = nullptr);
 
 // A view's depth range from its masks' visual hull and COLMAP's ranges of its sparse points:
 // the hull searched over [0.5 x, 2 x] the span of `all_points` and `in_mask` (the points
@@ -77,13 +89,16 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
 // the points: 3.4 x finer labels). Points that reach out of the hull disagree with the masks
 // and are left out: hair is hard to match, and neither range need cover it (synth_handheld
 // h02: its hair at 0.35-0.62 m, its points in the mask 0.69 m away and more, COLMAP's range of
-// all its points from 1.14 m). When the hull reaches the search's start, or no ray meets it
-// there, every point may lie behind the head (on the room only: a head without sparse points),
-// and the search starts 4, 16 and then 64 times nearer until the hull's near end lies inside
-// it (*searched_nearer = true; the points do not narrow such a range), unless the other
-// views' masks keep more than half their pixels (masks drawn loosely or not at all carve
-// nothing near the views); a hull that still reaches the start is taken as first found.
-// Returns false (outputs untouched) when the hull gives no range.
+// all its points from 1.14 m). When no ray meets the hull in the search, or the hull reaches
+// the search's start and none of the points in the mask lies within it, every point may lie
+// behind the head (on the room only: a head without sparse points), and the search starts 4,
+// 16 and then 64 times nearer until the hull's near end lies inside it. (Points in the mask
+// within the hull are on the head: a close-up's frusta meet in front of them, and its hull
+// reaches the start.) Such a nearer range counts only where the masks, not the views'
+// frusta, cut most of its rays' near ends (HullNearEnd::masks_cut_fraction at least 0.5):
+// then *searched_nearer = true, and the points do not narrow it. Otherwise the first search's
+// range stands, as found (narrowed by the points, or none). Returns false (outputs untouched)
+// when that gives no range.
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              const DepthRange& all_points, const DepthRange& in_mask,

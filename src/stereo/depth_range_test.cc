@@ -38,14 +38,17 @@ struct Scene {
   std::vector<std::pair<StereoCamera, FloatMap>> others;
 };
 
-// Reference at the origin looking at the sphere; others on a ring of radius 1 around it.
-Scene MakeScene(int num_others) {
+// Reference `ref_distance` in front of the sphere's centre (at the origin by default) looking
+// at it; others on a ring of radius `distance` around it.
+Scene MakeScene(int num_others, double distance = 1, double ref_distance = 1) {
   Scene scene;
-  scene.ref = LookAtCamera(Eigen::Vector3d::Zero(), kCentre, 200, 160, 120);
+  scene.ref =
+      LookAtCamera(kCentre - Eigen::Vector3d(0, 0, ref_distance), kCentre, 200, 160, 120);
   for (int i = 1; i <= num_others; ++i) {
     const double angle = 2 * M_PI * i / (num_others + 1);
     const Eigen::Vector3d centre =
-        kCentre + Eigen::Vector3d(std::sin(angle), 0.3 * std::cos(3 * angle), -std::cos(angle));
+        kCentre + distance * Eigen::Vector3d(std::sin(angle), 0.3 * std::cos(3 * angle),
+                                             -std::cos(angle));
     const StereoCamera camera = LookAtCamera(centre, kCentre, 200, 160, 120);
     scene.others.emplace_back(camera, SphereMask(camera));
   }
@@ -224,14 +227,25 @@ TEST(DepthRangeTest, HullAndPointsRangeKeepsTheHullWhenThePointsDisagree) {
 }
 
 // Every point behind the sphere (on a room behind the head, say): searched from half their
-// near end, the hull reaches the search's start, so it is searched again nearer; points that
-// lie within the hull found so do not narrow it.
+// near end, no ray meets the hull (points from 2.5 m: the search starts at 1.25 m, behind the
+// sphere) or the hull reaches the search's start (points in the mask from 1.9 m: it starts
+// at 0.95 m, inside the sphere), so it is searched again nearer; points that lie within the
+// hull found so do not narrow it.
 TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHull) {
   const Scene scene = MakeScene(7);
   const FloatMap mask = SphereMask(scene.ref);
   double min_m = 0, max_m = 0;
   bool narrowed = true, nearer = false;
-  for (const DepthRange& in_mask : {Points(-1, -1, false), Points(2.5, 4.0, true)}) {
+  HullNearEnd near_end;
+  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.95, 10.0, &min_m, &max_m,
+                                   VisualHullRangeOptions(), &near_end));
+  EXPECT_TRUE(near_end.at_search_start);
+  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.3, 10.0, &min_m, &max_m,
+                                   VisualHullRangeOptions(), &near_end));
+  EXPECT_FALSE(near_end.at_search_start);
+  EXPECT_GT(near_end.masks_cut_fraction, 0.9);
+  for (const DepthRange& in_mask :
+       {Points(-1, -1, false), Points(2.5, 4.0, true), Points(1.9, 3.0, true)}) {
     ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(2.5, 5.0, false),
                                         in_mask, &min_m, &max_m, &narrowed, &nearer));
     EXPECT_TRUE(nearer);
@@ -242,7 +256,7 @@ TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHu
     EXPECT_LT(max_m, 1.3);
   }
   // Masks that keep whole images carve nothing: the first search's range stands (searched
-  // nearer, the hull would run up to the frusta's meeting near the views).
+  // nearer, the hull would run up to where the frusta meet, near the views).
   Scene unmasked = MakeScene(7);
   for (auto& view : unmasked.others) view.second = FloatMap(160, 120, 1, 1.0f);
   double first_min = 0, first_max = 0;
@@ -254,6 +268,28 @@ TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHu
   EXPECT_FALSE(nearer);
   EXPECT_EQ(min_m, first_min);
   EXPECT_EQ(max_m, first_max);
+}
+
+// A close-up (the reference 0.15 m from the sphere's front, the others on a ring of 0.4 m)
+// with its points on the sphere's front: the views' cones meet in front of the search's start,
+// so that the hull reaches it, but the points lie within the hull: the range they narrow it to
+// stands (searched nearer, the hull would run up to 0.02 m).
+TEST(DepthRangeTest, ACloseUpWithPointsInItsHullIsNotSearchedNearer) {
+  const Scene scene = MakeScene(7, 0.4, 0.25);
+  const FloatMap mask = SphereMask(scene.ref);
+  double min_m = 0, max_m = 0;
+  HullNearEnd near_end;
+  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.075, 0.5, &min_m, &max_m,
+                                   VisualHullRangeOptions(), &near_end));
+  EXPECT_TRUE(near_end.at_search_start);
+  bool narrowed = false, nearer = true;
+  ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(0.15, 0.25, true),
+                                      Points(0.15, 0.25, true), &min_m, &max_m, &narrowed,
+                                      &nearer));
+  EXPECT_FALSE(nearer);
+  EXPECT_TRUE(narrowed);
+  EXPECT_EQ(min_m, 0.15);
+  EXPECT_EQ(max_m, 0.25);
 }
 
 TEST(DepthRangeTest, ViewsThatDoNotSeeThePointDoNotVeto) {

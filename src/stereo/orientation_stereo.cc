@@ -755,10 +755,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
             LOG(WARNING) << name << ": the masks' visual hull lies in front of every sparse "
                          << "point of this view (the hull from " << hull_min
                          << " m, the points from " << range.min_m
-                         << " m): the depth range is the hull's. Points on the room alone, "
-                            "none on the head, do that; so do points or poses that are wrong. "
-                            "Check the sparse model, or give --OrientationStereo.depth_min and "
-                            "depth_max";
+                         << " m): the automatic depth bounds are the hull's. Points on the "
+                            "room alone, none on the head, do that; so do points or poses that "
+                            "are wrong. Check the sparse model, or give "
+                            "--OrientationStereo.depth_min and depth_max";
           }
           if (options.depth_min <= 0) depth_min = hull_min;
           if (options.depth_max <= 0) depth_max = hull_max;
