@@ -276,7 +276,7 @@ int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
 
 double SourceScaleRatio(const StereoViewData& ref, const StereoViewData& source,
                         const DepthLabels& labels) {
-  return ImageScaleRatio(ref.camera, source.camera, labels.Depth(0.5 * (labels.num_labels - 1)));
+  return ImageScaleRatio(ref.camera, source.camera, labels.Depth(labels.MiddleLabel()));
 }
 
 int SourceLevelOffset(double ratio, bool match_scale) {

@@ -743,8 +743,8 @@ TEST(DepthEstimator, SourceLevelsFollowTheScaleAtWhichTheyImage) {
   EXPECT_EQ(SourceLevelOffset(0, true), 0);  // the point behind the source
   // The best-matched level's mismatch over the 3 levels: none at twice or half the scale
   // matched, twice level for level; at 8 / 6 times the levels run out (the reference's level 0
-  // meets the source's level 2 at 2 / 1.5 times); at a tenth only the reference's level 2
-  // meets a level of the source's, its level 0, 2.5 times off.
+  // meets the source's level 2 at 2 / 1.5 times); at a tenth every level meets the source's
+  // level 0, 10, 5 and 2.5 times off, the best 2.5.
   EXPECT_DOUBLE_EQ(BestLevelScaleMismatch(others[3], 2.0, 1, false, 3), 1.0);
   EXPECT_DOUBLE_EQ(BestLevelScaleMismatch(others[3], 2.0, 0, false, 3), 2.0);
   EXPECT_DOUBLE_EQ(BestLevelScaleMismatch(others[4], 0.5, -1, false, 3), 1.0);

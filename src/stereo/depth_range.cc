@@ -48,7 +48,8 @@ HullSample ClassifyHullSample(const std::vector<Projection>& projections, int mi
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              double search_min_m, double search_max_m,
-                             const VisualHullRangeOptions& options, FloatMap* masks_cut_near_end) {
+                             const VisualHullRangeOptions& options,
+                             FloatMap* near_end_causes) {
   const int pixel_step = options.pixel_step;
   const bool find_far_ends = options.find_far_ends;
   CHECK_EQ(ref_mask.Width(), ref.width);
@@ -56,7 +57,7 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
   CHECK_GT(pixel_step, 0);
   CHECK_GE(options.num_samples, 2);
   FloatMap intervals(ref.width, ref.height, 2, 0.0f);
-  if (masks_cut_near_end != nullptr) *masks_cut_near_end = FloatMap(ref.width, ref.height, 1);
+  if (near_end_causes != nullptr) *near_end_causes = FloatMap(ref.width, ref.height, 1);
   if (!(search_min_m > 0 && search_max_m > search_min_m)) return intervals;
   std::vector<Projection> projections;
   for (const auto& [camera, mask] : others) {
@@ -87,13 +88,21 @@ FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
       };
       auto inside = [&](double k) { return classify(k) == HullSample::kInside; };
       int entry = -1;
+      HullSample in_front = HullSample::kUnobserved;  // the sample before the entry
       for (int k = 0; k < n && entry < 0; ++k) {
-        if (inside(k)) entry = k;
+        const HullSample sample = classify(k);
+        if (sample == HullSample::kInside) {
+          entry = k;
+        } else {
+          in_front = sample;
+        }
       }
       if (entry < 0) continue;
-      if (masks_cut_near_end != nullptr && entry > 0 &&
-          classify(entry - 1) == HullSample::kCarved) {
-        masks_cut_near_end->At(row, col) = 1.0f;
+      if (near_end_causes != nullptr) {
+        const NearEndCause cause = entry == 0                          ? NearEndCause::kSearchStart
+                                   : in_front == HullSample::kCarved ? NearEndCause::kMasks
+                                                                     : NearEndCause::kFrusta;
+        near_end_causes->At(row, col) = static_cast<float>(cause);
       }
       int exit = n;  // first sample outside after the entry
       for (int k = entry + 1; find_far_ends && k < n; ++k) {
@@ -128,36 +137,40 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                           HullNearEnd* near_end) {
   VisualHullRangeOptions with_far_ends = options;
   with_far_ends.find_far_ends = true;
-  FloatMap masks_cut;
+  FloatMap causes;
   const FloatMap intervals = VisualHullIntervals(ref, ref_mask, others, search_min_m,
-                                                 search_max_m, with_far_ends, &masks_cut);
+                                                 search_max_m, with_far_ends, &causes);
   std::vector<double> near_ends, far_ends;
-  int num_cut = 0, num_inside_search = 0;
+  size_t num_at_start = 0, num_cut_by_masks = 0;
   for (size_t i = 0; i < intervals.NumPixels(); ++i) {
     if (intervals.Channel(0)[i] > 0) {
       near_ends.push_back(intervals.Channel(0)[i]);
       far_ends.push_back(intervals.Channel(1)[i]);
-      // A ray inside the hull at the first sample has its near end there (up to float
-      // rounding, 6e-8 relative; the first bisection step lies 1e-5 further).
-      if (intervals.Channel(0)[i] > search_min_m * (1 + 1e-6)) {
-        ++num_inside_search;
-        num_cut += masks_cut.Channel(0)[i] > 0;
-      }
+      const auto cause = static_cast<NearEndCause>(causes.Channel(0)[i]);
+      num_at_start += cause == NearEndCause::kSearchStart;
+      num_cut_by_masks += cause == NearEndCause::kMasks;
     }
   }
   if (static_cast<int>(near_ends.size()) < std::max(1, options.min_rays_in_hull)) return false;
-  const auto percentile = [](std::vector<double>* values, double percent) {
+  // The index of a percentile among `size` sorted values.
+  const auto percentile_index = [](size_t size, double percent) {
     const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
-    const size_t i = std::min(values->size() - 1, static_cast<size_t>(p * (values->size() - 1)));
+    return std::min(size - 1, static_cast<size_t>(p * (size - 1)));
+  };
+  const auto percentile = [&](std::vector<double>* values, double percent) {
+    const size_t i = percentile_index(values->size(), percent);
     std::nth_element(values->begin(), values->begin() + i, values->end());
     return (*values)[i];
   };
   const double lo = percentile(&near_ends, options.low_percentile);
   const double hi = percentile(&far_ends, options.high_percentile);
   if (near_end != nullptr) {
-    near_end->at_search_start = lo <= search_min_m * (1 + 1e-6);
-    near_end->masks_cut_fraction =
-        num_inside_search > 0 ? static_cast<double>(num_cut) / num_inside_search : 0;
+    // The low percentile is the search's start when more rays than its index begin there.
+    near_end->at_search_start =
+        num_at_start > percentile_index(near_ends.size(), options.low_percentile);
+    const size_t num_inside_search = near_ends.size() - num_at_start;
+    near_end->fraction_cut_by_masks =
+        num_inside_search > 0 ? static_cast<double>(num_cut_by_masks) / num_inside_search : 0;
   }
   const double margin = std::max(options.margin_fraction * (hi - lo), options.margin_m);
   *min_m = std::max(lo - margin, search_min_m);
@@ -168,8 +181,8 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              const DepthRange& all_points, const DepthRange& in_mask,
-                             double* min_m, double* max_m, bool* narrowed,
-                             bool* searched_nearer, const VisualHullRangeOptions& options) {
+                             double* min_m, double* max_m, HullRangeSource* source,
+                             const VisualHullRangeOptions& options) {
   double search_min = all_points.min_m, search_max = all_points.max_m;
   if (in_mask.inside_mask) {
     search_min = std::min(search_min, in_mask.min_m);
@@ -177,15 +190,14 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
   }
   if (!(search_min > 0 && search_max > search_min)) return false;
   // Each try searches 4 times nearer than the last, the first from half the points' near end.
-  // A nearer try counts only where the masks, not the views' frusta, cut the hull's near end:
-  // masks that carve nothing near the cameras (drawn loosely, or a close-up whose head fills
-  // the frames) leave a hull that runs up to where the frusta meet, which the points bound
-  // better.
+  // A nearer try counts only where the masks, not the views' frusta, cut most of its rays'
+  // near ends: masks that carve nothing near the cameras (drawn loosely) leave a hull that
+  // runs up to where the frusta meet, which the points bound better.
   constexpr int kNumTries = 4;
   constexpr double kNearerFactor = 4;
-  constexpr double kMinMasksCutFraction = 0.5;
+  constexpr double kMinFractionCutByMasks = 0.5;
   double hull_min = 0, hull_max = 0;
-  bool found = false;
+  bool found = false, nearer = false;
   for (int attempt = 0; attempt < kNumTries; ++attempt) {
     const double start = 0.5 * search_min / std::pow(kNearerFactor, attempt);
     double try_min = 0, try_max = 0;
@@ -194,25 +206,28 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                               options, &near_end)) {
       continue;
     }
-    const bool cut_by_masks =
-        !near_end.at_search_start && near_end.masks_cut_fraction >= kMinMasksCutFraction;
+    const bool cut_by_masks = !near_end.at_search_start &&
+                              near_end.fraction_cut_by_masks >= kMinFractionCutByMasks;
     if (attempt == 0 || cut_by_masks) {
       hull_min = try_min;
       hull_max = try_max;
-      *searched_nearer = attempt > 0;
+      nearer = attempt > 0;
       found = true;
     }
-    // Points in the mask within the first search's hull are on the head (a close-up's frusta
-    // meet in front of them, so that its hull reaches the start): no nearer search.
-    const bool points_in_hull = attempt == 0 && in_mask.inside_mask &&
-                                in_mask.max_m >= try_min && in_mask.min_m <= try_max;
-    if (!near_end.at_search_start || points_in_hull) break;
+    // Points in the mask overlapping the first search's hull are on the head (a close-up's
+    // cones meet in front of them, so that its hull reaches the start): no nearer search.
+    const bool points_overlap_hull = attempt == 0 && in_mask.inside_mask &&
+                                     in_mask.max_m >= try_min && in_mask.min_m <= try_max;
+    if (!near_end.at_search_start || points_overlap_hull) break;
   }
   if (!found) return false;
-  *narrowed = !*searched_nearer && in_mask.inside_mask && in_mask.min_m >= hull_min &&
-              in_mask.max_m <= hull_max;
-  *min_m = *narrowed ? in_mask.min_m : hull_min;
-  *max_m = *narrowed ? in_mask.max_m : hull_max;
+  const bool narrowed =
+      !nearer && in_mask.inside_mask && in_mask.min_m >= hull_min && in_mask.max_m <= hull_max;
+  *source = nearer     ? HullRangeSource::kHullInFrontOfPoints
+            : narrowed ? HullRangeSource::kPointsWithinHull
+                       : HullRangeSource::kHull;
+  *min_m = narrowed ? in_mask.min_m : hull_min;
+  *max_m = narrowed ? in_mask.max_m : hull_max;
   return true;
 }
 

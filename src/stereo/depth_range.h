@@ -50,23 +50,28 @@ struct VisualHullRangeOptions {
 // lies inside every mask that sees it, hence inside the hull. (The far end is no such bound: a
 // phantom stretch of hull, carved by no view, may lie in front of the surface.) The ends are
 // refined by bisection between the depth samples; the far ends only with
-// options.find_far_ends. *masks_cut_near_end (if given): 1 at the sampled pixels whose ray
-// enters the hull after the search's start where a mask carved the sample in front (0 where
-// the views' frusta did: too few views saw it).
+// options.find_far_ends. *near_end_causes (if given): per sampled pixel whose ray enters the
+// hull, what ends the hull in front of its near end (NearEndCause as a float; 0 elsewhere).
+enum class NearEndCause {
+  kNone = 0,
+  kSearchStart = 1,  // inside the hull at the search's first sample
+  kFrusta = 2,       // the sample in front seen by too few views
+  kMasks = 3,        // the sample in front carved by the masks
+};
 FloatMap VisualHullIntervals(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              double search_min_m, double search_max_m,
                              const VisualHullRangeOptions& options = VisualHullRangeOptions(),
-                             FloatMap* masks_cut_near_end = nullptr);
+                             FloatMap* near_end_causes = nullptr);
 
 // Where VisualHullDepthRange's hull begins.
 struct HullNearEnd {
   // The low percentile of the rays' near ends is the search's start: the hull may go on in
   // front of it.
   bool at_search_start = false;
-  // Of the rays entering the hull after the search's start, the fraction where a mask cut the
-  // near end (masks_cut_near_end).
-  double masks_cut_fraction = 0;
+  // Of the rays entering the hull after the search's start, the fraction whose near end the
+  // masks cut (NearEndCause::kMasks).
+  double fraction_cut_by_masks = 0;
 };
 
 // Masks are 1 = keep, 0 = excluded, each at its camera's width x height; cameras in the SfM
@@ -90,20 +95,24 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
 // and are left out: hair is hard to match, and neither range need cover it (synth_handheld
 // h02: its hair at 0.35-0.62 m, its points in the mask 0.69 m away and more, COLMAP's range of
 // all its points from 1.14 m). When no ray meets the hull in the search, or the hull reaches
-// the search's start and none of the points in the mask lies within it, every point may lie
+// the search's start and the points in the mask do not overlap its range, every point may lie
 // behind the head (on the room only: a head without sparse points), and the search starts 4,
 // 16 and then 64 times nearer until the hull's near end lies inside it. (Points in the mask
-// within the hull are on the head: a close-up's frusta meet in front of them, and its hull
+// overlapping the hull are on the head: a close-up's cones meet in front of them, and its hull
 // reaches the start.) Such a nearer range counts only where the masks, not the views'
-// frusta, cut most of its rays' near ends (HullNearEnd::masks_cut_fraction at least 0.5):
-// then *searched_nearer = true, and the points do not narrow it. Otherwise the first search's
-// range stands, as found (narrowed by the points, or none). Returns false (outputs untouched)
-// when that gives no range.
+// frusta, cut most of its rays' near ends (HullNearEnd::fraction_cut_by_masks at least 0.5),
+// and the points do not narrow it. Otherwise the first search's range stands, as found
+// (narrowed to the points, or none). Returns false (outputs untouched) when that gives no
+// range.
+enum class HullRangeSource {
+  kHull,                // the hull's range
+  kPointsWithinHull,    // the points in the mask, within the hull's range
+  kHullInFrontOfPoints  // the hull's, searched in front of every point
+};
 bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              const std::vector<std::pair<StereoCamera, FloatMap>>& others,
                              const DepthRange& all_points, const DepthRange& in_mask,
-                             double* min_m, double* max_m, bool* narrowed,
-                             bool* searched_nearer,
+                             double* min_m, double* max_m, HullRangeSource* source,
                              const VisualHullRangeOptions& options = VisualHullRangeOptions());
 
 }  // namespace hairmvs

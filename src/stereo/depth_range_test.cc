@@ -197,97 +197,99 @@ TEST(DepthRangeTest, HullAndPointsRangeKeepsTheHullWhenThePointsDisagree) {
   EXPECT_GE(min_m, 1.0);
   // The points in the mask are wrong too (behind the sphere and beyond), but nearer than the
   // room's: the hull is searched from half their near end and kept as it is.
-  bool narrowed = true, nearer = true;
+  HullRangeSource source = HullRangeSource::kPointsWithinHull;
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
-                                      Points(0.7, 3.0, true), &min_m, &max_m, &narrowed,
-                                      &nearer));
-  EXPECT_FALSE(narrowed);
-  EXPECT_FALSE(nearer);
+                                      Points(0.7, 3.0, true), &min_m, &max_m, &source));
+  EXPECT_EQ(source, HullRangeSource::kHull);
   EXPECT_LT(min_m, 0.9);
   EXPECT_GT(max_m, 1.1);
   EXPECT_LT(max_m - min_m, 0.5);
   // Points in the mask whose range lies within the hull's narrow it (a long T-group hull).
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, room,
-                                      Points(0.92, 1.08, true), &min_m, &max_m, &narrowed,
-                                      &nearer));
-  EXPECT_TRUE(narrowed);
-  EXPECT_FALSE(nearer);
+                                      Points(0.92, 1.08, true), &min_m, &max_m, &source));
+  EXPECT_EQ(source, HullRangeSource::kPointsWithinHull);
   EXPECT_EQ(min_m, 0.92);
   EXPECT_EQ(max_m, 1.08);
   // Not from the mask (COLMAP's fallback to all points): never narrows.
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(0.6, 3.0, false),
-                                      Points(0.92, 1.08, false), &min_m, &max_m, &narrowed,
-                                      &nearer));
-  EXPECT_FALSE(narrowed);
+                                      Points(0.92, 1.08, false), &min_m, &max_m, &source));
+  EXPECT_EQ(source, HullRangeSource::kHull);
   EXPECT_LT(min_m, 0.9);
   // No points at all: no range.
   EXPECT_FALSE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(-1, -1, false),
-                                       Points(-1, -1, false), &min_m, &max_m, &narrowed,
-                                       &nearer));
+                                       Points(-1, -1, false), &min_m, &max_m, &source));
+}
+
+// Where the hull searched from `start` to `end` begins.
+HullNearEnd NearEnd(const Scene& scene, const FloatMap& mask, double start, double end) {
+  double min_m = 0, max_m = 0;
+  HullNearEnd near_end;
+  EXPECT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, start, end, &min_m, &max_m,
+                                   VisualHullRangeOptions(), &near_end));
+  return near_end;
 }
 
 // Every point behind the sphere (on a room behind the head, say): searched from half their
 // near end, no ray meets the hull (points from 2.5 m: the search starts at 1.25 m, behind the
 // sphere) or the hull reaches the search's start (points in the mask from 1.9 m: it starts
-// at 0.95 m, inside the sphere), so it is searched again nearer; points that lie within the
-// hull found so do not narrow it.
+// at 0.95 m, inside the sphere), so it is searched again nearer, where the masks cut the
+// hull's near ends; points that lie within the hull found so do not narrow it.
 TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHull) {
   const Scene scene = MakeScene(7);
   const FloatMap mask = SphereMask(scene.ref);
+  EXPECT_TRUE(NearEnd(scene, mask, 0.95, 10.0).at_search_start);
+  const HullNearEnd nearer = NearEnd(scene, mask, 0.3, 10.0);
+  EXPECT_FALSE(nearer.at_search_start);
+  EXPECT_GT(nearer.fraction_cut_by_masks, 0.9);
   double min_m = 0, max_m = 0;
-  bool narrowed = true, nearer = false;
-  HullNearEnd near_end;
-  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.95, 10.0, &min_m, &max_m,
-                                   VisualHullRangeOptions(), &near_end));
-  EXPECT_TRUE(near_end.at_search_start);
-  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.3, 10.0, &min_m, &max_m,
-                                   VisualHullRangeOptions(), &near_end));
-  EXPECT_FALSE(near_end.at_search_start);
-  EXPECT_GT(near_end.masks_cut_fraction, 0.9);
   for (const DepthRange& in_mask :
        {Points(-1, -1, false), Points(2.5, 4.0, true), Points(1.9, 3.0, true)}) {
+    HullRangeSource source = HullRangeSource::kHull;
     ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(2.5, 5.0, false),
-                                        in_mask, &min_m, &max_m, &narrowed, &nearer));
-    EXPECT_TRUE(nearer);
-    EXPECT_FALSE(narrowed);
+                                        in_mask, &min_m, &max_m, &source));
+    EXPECT_EQ(source, HullRangeSource::kHullInFrontOfPoints);
     EXPECT_LT(min_m, 0.9);
     EXPECT_GT(min_m, 0.8);
     EXPECT_GT(max_m, 1.05);
     EXPECT_LT(max_m, 1.3);
   }
-  // Masks that keep whole images carve nothing: the first search's range stands (searched
-  // nearer, the hull would run up to where the frusta meet, near the views).
-  Scene unmasked = MakeScene(7);
-  for (auto& view : unmasked.others) view.second = FloatMap(160, 120, 1, 1.0f);
-  double first_min = 0, first_max = 0;
-  ASSERT_TRUE(VisualHullDepthRange(unmasked.ref, mask, unmasked.others, 1.25, 10.0, &first_min,
+}
+
+// Masks that keep whole images carve nothing: searched nearer, only the views' frusta would
+// cut the hull's near ends (up to where they meet, near the views), so the first search's
+// range stands.
+TEST(DepthRangeTest, MasksThatCarveNothingAreNotSearchedNearer) {
+  Scene scene = MakeScene(7);
+  const FloatMap mask = SphereMask(scene.ref);
+  for (auto& view : scene.others) view.second = FloatMap(160, 120, 1, 1.0f);
+  EXPECT_TRUE(NearEnd(scene, mask, 1.25, 10.0).at_search_start);
+  const HullNearEnd nearer = NearEnd(scene, mask, 1.25 / 64, 10.0);
+  EXPECT_FALSE(nearer.at_search_start);
+  EXPECT_EQ(nearer.fraction_cut_by_masks, 0.0);
+  double first_min = 0, first_max = 0, min_m = 0, max_m = 0;
+  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 1.25, 10.0, &first_min,
                                    &first_max));
-  ASSERT_TRUE(HullAndPointsDepthRange(unmasked.ref, mask, unmasked.others,
-                                      Points(2.5, 5.0, false), Points(-1, -1, false), &min_m,
-                                      &max_m, &narrowed, &nearer));
-  EXPECT_FALSE(nearer);
+  HullRangeSource source = HullRangeSource::kHullInFrontOfPoints;
+  ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(2.5, 5.0, false),
+                                      Points(-1, -1, false), &min_m, &max_m, &source));
+  EXPECT_EQ(source, HullRangeSource::kHull);
   EXPECT_EQ(min_m, first_min);
   EXPECT_EQ(max_m, first_max);
 }
 
 // A close-up (the reference 0.15 m from the sphere's front, the others on a ring of 0.4 m)
 // with its points on the sphere's front: the views' cones meet in front of the search's start,
-// so that the hull reaches it, but the points lie within the hull: the range they narrow it to
-// stands (searched nearer, the hull would run up to 0.02 m).
+// so that the hull reaches it, but the points overlap the hull's range: the range they narrow
+// it to stands (searched nearer, the hull would run up to 0.02 m).
 TEST(DepthRangeTest, ACloseUpWithPointsInItsHullIsNotSearchedNearer) {
   const Scene scene = MakeScene(7, 0.4, 0.25);
   const FloatMap mask = SphereMask(scene.ref);
+  EXPECT_TRUE(NearEnd(scene, mask, 0.075, 0.5).at_search_start);
   double min_m = 0, max_m = 0;
-  HullNearEnd near_end;
-  ASSERT_TRUE(VisualHullDepthRange(scene.ref, mask, scene.others, 0.075, 0.5, &min_m, &max_m,
-                                   VisualHullRangeOptions(), &near_end));
-  EXPECT_TRUE(near_end.at_search_start);
-  bool narrowed = false, nearer = true;
+  HullRangeSource source = HullRangeSource::kHullInFrontOfPoints;
   ASSERT_TRUE(HullAndPointsDepthRange(scene.ref, mask, scene.others, Points(0.15, 0.25, true),
-                                      Points(0.15, 0.25, true), &min_m, &max_m, &narrowed,
-                                      &nearer));
-  EXPECT_FALSE(nearer);
-  EXPECT_TRUE(narrowed);
+                                      Points(0.15, 0.25, true), &min_m, &max_m, &source));
+  EXPECT_EQ(source, HullRangeSource::kPointsWithinHull);
   EXPECT_EQ(min_m, 0.15);
   EXPECT_EQ(max_m, 0.25);
 }

@@ -545,10 +545,9 @@ void WarnOfMismatchedSources(const std::string& name, const StereoViewData& ref,
   // The orientation fields' filters are in pixels: a source that images the hair at another
   // scale sees other strands' bands at the same level, and its depths lean behind (the README
   // measures it). Matched at other levels, one level that matches suffices: close-ups whose
-  // sources image the hair at a third of their scale, so that their finest level meets a
-  // source's level three times off, still score well (the README's mixed T groups). Level for
-  // level, synth_handheld's close-up h14, whose sources image the hair at 0.56-0.65 times its
-  // scale, scored 3.73 mm, among its best views: warned beyond 1.85 times.
+  // finest level meets a source's level three times off still score well (the README's mixed
+  // T groups). Level for level, synth_handheld's close-up h14 scored among its best views with
+  // its sources at 0.56-0.65 times its scale: warned beyond 1.85 times.
   constexpr double kMaxImageScaleRatio = 1.85;
   const bool colour = options.MatchesColour();
   const int num_levels =
@@ -561,7 +560,7 @@ void WarnOfMismatchedSources(const std::string& name, const StereoViewData& ref,
     if (mismatch > kMaxImageScaleRatio) {
       LOG(WARNING) << name << ": source " << source_names[s] << " images the hair at "
                    << std::setprecision(3) << ratio << " times this view's scale (px per metre "
-                   << "at " << labels.Depth(0.5 * (labels.num_labels - 1)) << " m), and the "
+                   << "at " << labels.Depth(labels.MiddleLabel()) << " m), and the "
                    << "levels of it that this view's levels meet are at best " << mismatch
                    << " times off: orientation fields do not match across scales, so that its "
                       "depths lean behind; give the views closer scales (images of one size, "
@@ -740,19 +739,21 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         VisualHullRangeOptions hull_options;
         hull_options.min_carving_views = options.visual_hull_min_carving_views;
         double hull_min = 0, hull_max = 0;
-        bool narrowed = false, searched_nearer = false;
+        HullRangeSource hull_source = HullRangeSource::kHull;
         if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
             HullAndPointsDepthRange(ref.camera, mask, others(),
                                     // Without points in the mask, `range` has all of them.
                                     range.inside_mask
                                         ? ComputeDepthRange(workspace.Model(), image_id)
                                         : range,
-                                    range, &hull_min, &hull_max, &narrowed, &searched_nearer,
-                                    hull_options)) {
-          range_source = narrowed ? "visual hull and sparse points in mask" : "visual hull";
-          if (searched_nearer) {
-            range_source = "visual hull, in front of the sparse points";
-            LOG(WARNING) << name << ": the masks' visual hull lies in front of every sparse "
+                                    range, &hull_min, &hull_max, &hull_source, hull_options)) {
+          range_source = hull_source == HullRangeSource::kPointsWithinHull
+                             ? "visual hull and sparse points in mask"
+                         : hull_source == HullRangeSource::kHullInFrontOfPoints
+                             ? "visual hull, in front of the sparse points"
+                             : "visual hull";
+          if (hull_source == HullRangeSource::kHullInFrontOfPoints) {
+            LOG(WARNING) << name << ": the masks' visual hull begins in front of every sparse "
                          << "point of this view (the hull from " << hull_min
                          << " m, the points from " << range.min_m
                          << " m): the automatic depth bounds are the hull's. Points on the "

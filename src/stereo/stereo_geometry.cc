@@ -55,7 +55,7 @@ double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double 
 }
 
 double LabelStepPxPerRadian(const StereoCamera& ref, const DepthLabels& labels) {
-  const double v = 0.5 * (labels.num_labels - 1);
+  const double v = labels.MiddleLabel();
   const double near = labels.Depth(v), far = labels.Depth(v + 1);
   return MeanFocalPx(ref.K) * std::abs(1.0 / near - 1.0 / far) * 0.5 * (near + far);
 }

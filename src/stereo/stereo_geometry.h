@@ -81,8 +81,9 @@ double ViewingAngleDeg(const StereoCamera& a, const StereoCamera& b);
 
 // How much larger `src` images the point of the reference's optical axis at z-depth `depth`
 // than the reference does: (f_src / z_src) / (f_ref / depth), the focal lengths (MeanFocalPx)
-// over each camera's z-depth of the point; 0 when the point lies behind `src`. The orientation fields' filters are in pixels: across a ratio far from 1 they see the
-// strands at other scales.
+// over each camera's z-depth of the point; 0 when the point lies behind `src`. The orientation
+// fields' filters are in pixels: across a ratio far from 1 they see the strands at other
+// scales.
 double ImageScaleRatio(const StereoCamera& ref, const StereoCamera& src, double depth);
 
 // Depth labels: label value v in [0, num_labels - 1] (fractional values allowed) maps to
@@ -103,6 +104,8 @@ struct DepthLabels {
   }
   // Inverse of Depth().
   double Label(double depth) const { return ((inverse ? 1.0 / depth : depth) - a) / b; }
+  // The label in the middle of the range, (num_labels - 1) / 2.
+  double MiddleLabel() const { return 0.5 * (num_labels - 1); }
 };
 
 // The disparity step of one label in the middle of the range, v = (num_labels - 1) / 2, for
