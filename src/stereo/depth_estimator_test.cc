@@ -70,6 +70,7 @@ TEST(DepthEstimator, SmoothnessWeightsFollowEquation3) {
 struct Result {
   double median_abs_error_m = 0;
   double completeness = 0;
+  size_t num_compared = 0;  // pixels with both a depth and a true depth
   double fine_energy = 0;  // the fine stage's MRF energy
   FloatMap coarse_data_term;  // with options.write_cost_volume
   FloatMap depth;
@@ -82,6 +83,31 @@ FloatMap GreyToRgb(const FloatMap& gray) {
     std::copy(gray.Data().begin(), gray.Data().end(), rgb.Channel(c));
   }
   return rgb;
+}
+
+// Estimates the depth map of views[0] from the others over depth_min-depth_max (uniform in
+// inverse depth), and compares it with `true_depth` on the pixels where the truth exists.
+// `hull_entry`, `mask`: EstimateDepthMap's (empty: none).
+Result EstimateAndCompare(const std::vector<StereoViewData>& views, const FloatMap& true_depth,
+                          double depth_min, double depth_max,
+                          const OrientationStereoOptions& options,
+                          const FloatMap& hull_entry = FloatMap(),
+                          const FloatMap& mask = FloatMap()) {
+  std::vector<const StereoViewData*> sources;
+  for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
+  auto context = OpenCLContext::Create();
+  const DepthLabels labels(depth_min, depth_max, options.num_depths, true);
+  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, mask,
+                                                  hull_entry, labels, options, nullptr);
+  const size_t truth = std::count_if(true_depth.Data().begin(), true_depth.Data().end(),
+                                     [](float d) { return d > 0; });
+  Result result;
+  result.median_abs_error_m = MedianAbsError(estimate.depth, true_depth, &result.num_compared);
+  result.completeness = truth > 0 ? static_cast<double>(result.num_compared) / truth : 0;
+  result.fine_energy = estimate.fine_energy;
+  result.coarse_data_term = estimate.coarse_data_term.cost;
+  result.depth = estimate.depth;
+  return result;
 }
 
 // Renders the views, estimates the reference's depth map, compares with the truth on pixels
@@ -99,10 +125,6 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
     if (true_depth.Empty()) true_depth = view.depth;
     views.push_back({camera, Pyramid(view.orientation, 3), {}, Pyramid(GreyToRgb(view.gray), 3)});
   }
-  std::vector<const StereoViewData*> sources;
-  for (size_t i = 1; i < views.size(); ++i) sources.push_back(&views[i]);
-  auto context = OpenCLContext::Create();
-  const DepthLabels labels(depth_min, depth_max, options.num_depths, true);
   FloatMap hull_entry;
   if (hull_margin_m > 0) {
     hull_entry = FloatMap(true_depth.Width(), true_depth.Height(), 1);
@@ -111,18 +133,7 @@ Result Reconstruct(const Surface& surface, const std::vector<StereoCamera>& came
       if (d > 0) hull_entry.Data()[p] = d - static_cast<float>(hull_margin_m);
     }
   }
-  const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, mask,
-                                                  hull_entry, labels, options, nullptr);
-  const size_t truth = std::count_if(true_depth.Data().begin(), true_depth.Data().end(),
-                                     [](float d) { return d > 0; });
-  size_t estimated = 0;
-  Result result;
-  result.median_abs_error_m = MedianAbsError(estimate.depth, true_depth, &estimated);
-  result.completeness = truth > 0 ? static_cast<double>(estimated) / truth : 0;
-  result.fine_energy = estimate.fine_energy;
-  result.coarse_data_term = estimate.coarse_data_term.cost;
-  result.depth = estimate.depth;
-  return result;
+  return EstimateAndCompare(views, true_depth, depth_min, depth_max, options, hull_entry, mask);
 }
 
 OrientationStereoOptions TestOptions() {
@@ -789,17 +800,11 @@ TEST(DepthEstimator, SourcesAtTwiceTheScaleAreMatchedAtTheirNextCoarserLevel) {
     const FloatMap noise = testing_util::RandomMap(192, 144, 2, seed++);
     views.push_back({big, {noise, fine[0], fine[1]}, {}, {}});
   }
-  const std::vector<const StereoViewData*> sources = {&views[1], &views[2], &views[3]};
-  auto context = OpenCLContext::Create();
   OrientationStereoOptions options = TestOptions();
-  const DepthLabels labels(0.7, 1.5, options.num_depths, true);
   auto median_error = [&](const OrientationStereoOptions& o) {
-    const DepthEstimate estimate = EstimateDepthMap(context.get(), views[0], sources, FloatMap(),
-                                                    FloatMap(), labels, o, nullptr);
-    size_t count = 0;
-    const double error = MedianAbsError(estimate.depth, ref.depth, &count);
-    EXPECT_GT(count, ref.depth.NumPixels() / 2);
-    return error;
+    const Result result = EstimateAndCompare(views, ref.depth, 0.7, 1.5, o);
+    EXPECT_GT(result.num_compared, ref.depth.NumPixels() / 2);
+    return result.median_abs_error_m;
   };
   const double matched = median_error(options);
   options.match_source_scale = false;
