@@ -274,6 +274,17 @@ int SliceBlockThatFits(int slice_block, int num_labels, size_t bytes_per_slice,
   return block;
 }
 
+int CommonPyramidLevels(const StereoViewData& ref,
+                        const std::vector<const StereoViewData*>& sources, bool colour) {
+  int num_levels = static_cast<int>(ref.orientation.size());
+  if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(ref.rgb.size()));
+  for (const StereoViewData* src : sources) {
+    num_levels = std::min<int>(num_levels, static_cast<int>(src->orientation.size()));
+    if (colour) num_levels = std::min<int>(num_levels, static_cast<int>(src->rgb.size()));
+  }
+  return num_levels;
+}
+
 double SourceScaleRatio(const StereoViewData& ref, const StereoViewData& source,
                         const DepthLabels& labels) {
   return ImageScaleRatio(ref.camera, source.camera, labels.Depth(labels.MiddleLabel()));
@@ -316,17 +327,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   const bool colour = options.MatchesColour();
   // The pyramid levels every view has: the data term's (the first num_levels) and the coarse
   // stage's grid.
-  int num_pyramid_levels = static_cast<int>(ref.orientation.size());
-  for (const StereoViewData* src : sources) {
-    num_pyramid_levels =
-        std::min<int>(num_pyramid_levels, static_cast<int>(src->orientation.size()));
-    if (colour) {
-      num_pyramid_levels = std::min<int>(num_pyramid_levels, static_cast<int>(src->rgb.size()));
-    }
-  }
-  if (colour) {
-    num_pyramid_levels = std::min<int>(num_pyramid_levels, static_cast<int>(ref.rgb.size()));
-  }
+  const int num_pyramid_levels = CommonPyramidLevels(ref, sources, colour);
   THROW_IF(num_pyramid_levels < 1, "EstimateDepthMap: no common pyramid level");
   const int num_levels = std::min(options.num_levels, num_pyramid_levels);
   const int width0 = ref.orientation[0].Width();

@@ -45,6 +45,11 @@ double MeanSquareOfNonZero(const FloatMap& field);
 // are zero).
 FloatMap ScaleToRms(const FloatMap& field, double rms);
 
+// The pyramid levels that the reference and every source have (orientation fields, and colour
+// images if `colour`).
+int CommonPyramidLevels(const StereoViewData& ref,
+                        const std::vector<const StereoViewData*>& sources, bool colour);
+
 // The scale at which `source` images the point of the reference's centre ray at the depth
 // range's middle label, against the reference's (ImageScaleRatio; 0 where it lies behind it).
 double SourceScaleRatio(const StereoViewData& ref, const StereoViewData& source,

@@ -550,8 +550,8 @@ void WarnOfMismatchedSources(const std::string& name, const StereoViewData& ref,
   // its sources at 0.56-0.65 times its scale: warned beyond 1.85 times.
   constexpr double kMaxImageScaleRatio = 1.85;
   const bool colour = options.MatchesColour();
-  const int num_levels =
-      std::min<int>(options.num_levels, static_cast<int>(ref.orientation.size()));
+  // The data term's levels, as EstimateDepthMap takes them.
+  const int num_levels = std::min(options.num_levels, CommonPyramidLevels(ref, sources, colour));
   for (size_t s = 0; s < sources.size(); ++s) {
     const double ratio = SourceScaleRatio(ref, *sources[s], labels);
     const int offset = SourceLevelOffset(ratio, options.match_source_scale);
