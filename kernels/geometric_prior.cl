@@ -9,10 +9,11 @@
 // X_j = A X + a the point in view j's camera frame, C view j's centre in the reference's frame.
 // view_params, per view (20 floats): K_j A (9, row-major), the last row of A (3), K_j a (3),
 // a.z (1), K_ref C (3), 0.
-// view_dims, per view (4 ints): width and height of j's depth map, offset of the map in
-// depth_maps (2 ints: hm_plane_offset). A point is seen when X_j.z > 0 and its projection (SfM
-// convention: pixel (c, r) covers [c, c+1) x [r, r+1)) falls inside the map; j's surface on the
-// ray is
+// view_dims, per view (6 ints): width and height of j's depth map, offset of the map in
+// depth_maps (2 ints: hm_plane_offset), and the image pixel (col0, row0) that is the map's
+// pixel (0, 0) (a map of part of the image: FusionView::CropToDepth). A point is seen when
+// X_j.z > 0 and its projection (SfM convention: pixel (c, r) covers [c, c+1) x [r, r+1)) falls
+// inside the map; j's surface on the ray is
 // S = C + (X - C) * depth_j / X_j.z, projected back by K_ref.
 // ref_params (9 floats): K_ref^-1 (row-major).
 
@@ -66,8 +67,9 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
     const float3 k_a = (float3)(params[12], params[13], params[14]);
     const float a_z = params[15];
     const float3 k_ref_c = (float3)(params[16], params[17], params[18]);
-    const int map_width = view_dims[4 * j], map_height = view_dims[4 * j + 1];
-    __global const float* map = depth_maps + hm_plane_offset(view_dims + 4 * j);
+    __global const int* dims = view_dims + 6 * j;
+    const int map_width = dims[0], map_height = dims[1], col0 = dims[4], row0 = dims[5];
+    __global const float* map = depth_maps + hm_plane_offset(dims);
     for (int i = 0; i < count; ++i) {
       const float d = depth[i];
       float error = max_error_px;
@@ -75,8 +77,11 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
       if (xj_z > 0.0f) {
         const float3 uvw = d * k_a_ray + k_a;
         const float u = uvw.x / uvw.z, w = uvw.y / uvw.z;
-        if (u >= 0.0f && w >= 0.0f && u < (float)map_width && w < (float)map_height) {
-          const float map_depth = map[(int)w * map_width + (int)u];
+        // The image's pixel, then the map's: whole pixels, so that a part of the image is read
+        // exactly where the whole was.
+        if (u >= 0.0f && w >= 0.0f && u < (float)(col0 + map_width) &&
+            w < (float)(row0 + map_height) && (int)u >= col0 && (int)w >= row0) {
+          const float map_depth = map[((int)w - row0) * map_width + (int)u - col0];
           if (map_depth > 0.0f) {
             const float3 back = k_ref_c + (d * pixel - k_ref_c) * (map_depth / xj_z);
             if (back.z > 0.0f) {

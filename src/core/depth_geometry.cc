@@ -126,11 +126,13 @@ double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
 
 bool MapDepthOnRay(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                    const FloatMap& depth, const Eigen::Vector3d& world, double* z,
-                   double* map_depth) {
+                   double* map_depth, int col0, int row0) {
   const Eigen::Vector3d x = K * (R * world + t);
   if (!(x.z() > 0)) return false;
   *z = x.z();
-  *map_depth = SampleDepthMap(depth, x.x() / x.z(), x.y() / x.z(), MeanFocalPx(K));
+  // Exact where the point falls on the map: x - col0 lies in [0, x] and keeps x's fraction.
+  *map_depth =
+      SampleDepthMap(depth, x.x() / x.z() - col0, x.y() / x.z() - row0, MeanFocalPx(K));
   return *map_depth > 0;
 }
 

@@ -44,10 +44,11 @@ double SampleDepthMap(const FloatMap& depth, double x, double y, double focal,
 // Where the line of sight through a world point meets the depth map `depth` of the camera
 // X_cam = R X_world + t: the map's depth at the point's exact image position (SampleDepthMap,
 // focal the mean of K's two), and the point's own z-depth. False behind the camera, off the
-// map or where the map has no depth there.
+// map or where the map has no depth there. A map of part of the image has its pixel (0, 0) at
+// the image's (col0, row0).
 bool MapDepthOnRay(const Eigen::Matrix3d& K, const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
                    const FloatMap& depth, const Eigen::Vector3d& world, double* z,
-                   double* map_depth);
+                   double* map_depth, int col0 = 0, int row0 = 0);
 
 // Whether a w x h picture is one of width x height at another scale, to a pixel's rounding each
 // way: a depth map or mask that a max_image_size made smaller, not one of another aspect ratio.

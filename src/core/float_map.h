@@ -89,4 +89,13 @@ inline void PasteFloatMap(const FloatMap& part, int x0, int y0, FloatMap* whole)
   }
 }
 
+// A whole_width x whole_height map of zeros with `part` written at (x0, y0): what
+// CropFloatMap took, put back.
+inline FloatMap UncropFloatMap(const FloatMap& part, int x0, int y0, int whole_width,
+                               int whole_height) {
+  FloatMap whole(whole_width, whole_height, part.Channels());
+  PasteFloatMap(part, x0, y0, &whole);
+  return whole;
+}
+
 }  // namespace hairmvs

@@ -42,8 +42,10 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
     CHECK_EQ(view.normal.Channels(), 3) << view.name << ": normals are needed";
     const double focal = MeanFocalPx(view.K);
     FusionPoints& out = per_view[v];
-    for (int row = 0; row < view.depth.Height(); row += stride) {
-      for (int col = 0; col < view.depth.Width(); col += stride) {
+    // Every stride-th pixel of the image, whatever part of it the maps hold.
+    const auto first = [stride](int origin) { return (stride - origin % stride) % stride; };
+    for (int row = first(view.row0); row < view.depth.Height(); row += stride) {
+      for (int col = first(view.col0); col < view.depth.Width(); col += stride) {
         const float depth = view.depth.At(row, col);
         if (!(depth > 0)) continue;
         ++num_taken[v];

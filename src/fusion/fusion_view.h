@@ -25,16 +25,54 @@ struct FusionView {
   // (RunTemplateFusion computes them from the depth where the workspace has no normal map).
   FloatMap normal;
   FloatMap rgb;     // 3 channels (R, G, B) in [0, 1]; empty = grey
+  // The maps may hold only the box of the image where the depth map has depths (CropToDepth):
+  // hair fills a fifth of a view, and a workspace's maps are held at once. Their pixel (0, 0)
+  // is the image's (col0, row0), of a whole_width x whole_height image (0: never cropped); K is
+  // the whole image's. The methods below take and give the maps' pixels.
+  int col0 = 0, row0 = 0;
+  int whole_width = 0, whole_height = 0;
+
+  // Crops depth and the normal and rgb maps that are not empty to the box of the depth map's
+  // depths (nothing if it has none). Every method reads outside the box as no depth, as it
+  // read the zeros there, and at the same image positions: the results are the same, bit for
+  // bit.
+  void CropToDepth() {
+    if (whole_width == 0) {
+      whole_width = depth.Width();
+      whole_height = depth.Height();
+    }
+    const PixelBox box = BoundingBoxAbove(depth, 0.0f);
+    if (box.Empty()) return;
+    for (FloatMap* map : {&depth, &normal, &rgb}) {
+      if (!map->Empty()) *map = CropFloatMap(*map, box.x0, box.y0, box.width, box.height);
+    }
+    col0 += box.x0;
+    row0 += box.y0;
+  }
+  // `part`, a map of the maps' box (e.g. a depth map filtered here), in a whole map of zeros.
+  FloatMap Whole(const FloatMap& part) const {
+    return whole_width == 0 ? part : UncropFloatMap(part, col0, row0, whole_width, whole_height);
+  }
 
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // Projects a world point into the pixel grid (SfM convention: pixel (col,row) covers
   // [col, col+1) x [row, row+1)). Returns false behind the camera or outside the map.
   bool Project(const Eigen::Vector3d& world, int* col, int* row, double* z) const {
-    return ProjectToPixel(K, R, t, depth.Width(), depth.Height(), world, col, row, z);
+    if (!ProjectToPixel(K, R, t, col0 + depth.Width(), row0 + depth.Height(), world, col, row,
+                        z)) {
+      return false;
+    }
+    *col -= col0;
+    *row -= row0;
+    return *col >= 0 && *row >= 0;
   }
   // The world point this map's camera sees at pixel (col, row) with z-depth `z`.
   Eigen::Vector3d BackProject(int col, int row, double z) const {
-    return BackProjectPixelToWorld(K, R, t, col, row, z);
+    return BackProjectPixelToWorld(K, R, t, col + col0, row + row0, z);
+  }
+  // The image position of the centre of pixel (col, row) (SfM convention).
+  Eigen::Vector2d PixelCentre(int col, int row) const {
+    return Eigen::Vector2d(col + col0 + 0.5, row + row0 + 0.5);
   }
   // The point of this map's surface on the line of sight through `world`, whose own z-depth
   // is `z`, given the map's depth there: how the map "sees" that point.
@@ -46,7 +84,7 @@ struct FusionView {
   // point's exact image position) and the point's own z-depth: false behind the camera, off
   // the map or where the map has no depth there.
   bool DepthOnRay(const Eigen::Vector3d& world, double* z, double* map_depth) const {
-    return MapDepthOnRay(K, R, t, depth, world, z, map_depth);
+    return MapDepthOnRay(K, R, t, depth, world, z, map_depth, col0, row0);
   }
   Eigen::Vector3d WorldNormalAt(int row, int col) const {
     const Eigen::Vector3d n_cam(normal.At(row, col, 0), normal.At(row, col, 1),

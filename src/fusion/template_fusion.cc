@@ -279,6 +279,7 @@ TemplateFusionResult RunTemplateFusion(const std::string& workspace_path,
       }
       view.rgb = ResizeNearest(workspace.ReadViewRgb(name), view.depth.Width(),
                                view.depth.Height());
+      view.CropToDepth();
       views.push_back(std::move(view));
       image_idx_of_view.push_back(static_cast<uint32_t>(workspace.ImageIdx(name)));
     }

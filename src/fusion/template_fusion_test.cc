@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <random>
 #include <set>
 
 #include "src/core/test_util.h"
@@ -101,6 +102,68 @@ TEST(TemplateFusion, PointsAreSeenByTheViewsThatAgree) {
   EXPECT_LT(max_error, 1e-4);
   // 12 views around a sphere: most points are seen by several.
   EXPECT_GT(num_multi_view, points.Size() / 2);
+}
+
+// Views held cropped to their depths (FusionView::CropToDepth, as RunTemplateFusion holds
+// them) give the same points, bit for bit, at every stride (the crops' corners are not
+// multiples of it), and the same depths along any line of sight.
+TEST(TemplateFusion, ViewsCroppedToTheirDepthsGiveTheSamePoints) {
+  testing::SceneOptions scene;
+  std::vector<FusionView> whole = testing::RenderViews(testing::SphereSdf(1.0), scene);
+  for (FusionView& view : whole) {  // a colour per pixel, so that a shifted read shows
+    view.rgb = FloatMap(view.depth.Width(), view.depth.Height(), 3);
+    for (size_t i = 0; i < view.rgb.Data().size(); ++i) view.rgb.Data()[i] = (i % 251) / 250.0f;
+  }
+  std::vector<FusionView> cropped = whole;
+  int num_odd_corners = 0;
+  for (FusionView& view : cropped) {
+    view.CropToDepth();
+    EXPECT_GT(view.col0 + view.row0, 0);
+    EXPECT_LT(view.depth.NumPixels(), view.whole_width * view.whole_height);
+    num_odd_corners += view.col0 % 2 + view.row0 % 2;
+  }
+  EXPECT_GT(num_odd_corners, 0);
+  for (const int stride : {1, 2, 3}) {
+    TemplateFusionOptions options = TestOptions();
+    options.point_stride_px = stride;
+    int num_whole = 0, num_cropped = 0;
+    const FusionPoints from_whole = ExtractFusionPoints(whole, options, &num_whole);
+    const FusionPoints from_cropped = ExtractFusionPoints(cropped, options, &num_cropped);
+    ASSERT_GT(from_whole.Size(), 100u) << stride;
+    EXPECT_EQ(num_cropped, num_whole) << stride;
+    ASSERT_EQ(from_cropped.Size(), from_whole.Size()) << stride;
+    for (size_t i = 0; i < from_whole.Size(); ++i) {
+      ASSERT_EQ(from_cropped.xyz[i], from_whole.xyz[i]) << stride << " " << i;
+      ASSERT_EQ(from_cropped.normal[i], from_whole.normal[i]) << stride << " " << i;
+      ASSERT_EQ(from_cropped.rgb[i], from_whole.rgb[i]) << stride << " " << i;
+      ASSERT_EQ(from_cropped.visible_views[i], from_whole.visible_views[i]) << stride << " " << i;
+    }
+  }
+  EXPECT_EQ(MedianPixelFootprint(cropped), MedianPixelFootprint(whole));
+  // Lines of sight through points on, in front of and behind the sphere, and beside it.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-1.3, 1.3);
+  int num_seen = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d world(coordinate(rng), coordinate(rng), coordinate(rng));
+    for (size_t v = 0; v < whole.size(); ++v) {
+      double z_whole = 0, z_cropped = 0, depth_whole = 0, depth_cropped = 0;
+      const bool on_whole = whole[v].DepthOnRay(world, &z_whole, &depth_whole);
+      ASSERT_EQ(cropped[v].DepthOnRay(world, &z_cropped, &depth_cropped), on_whole);
+      EXPECT_EQ(depth_cropped, depth_whole);
+      num_seen += on_whole;
+      int col_whole, row_whole, col_cropped, row_cropped;
+      if (whole[v].Project(world, &col_whole, &row_whole, &z_whole) &&
+          whole[v].depth.At(row_whole, col_whole) > 0) {
+        ASSERT_TRUE(cropped[v].Project(world, &col_cropped, &row_cropped, &z_cropped));
+        EXPECT_EQ(col_cropped + cropped[v].col0, col_whole);
+        EXPECT_EQ(row_cropped + cropped[v].row0, row_whole);
+        EXPECT_EQ(cropped[v].BackProject(col_cropped, row_cropped, 0.7),
+                  whole[v].BackProject(col_whole, row_whole, 0.7));
+      }
+    }
+  }
+  EXPECT_GT(num_seen, 1000);
 }
 
 // Every view twice, once with its normals turned around: each voxel's normals cancel and the

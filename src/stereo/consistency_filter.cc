@@ -42,7 +42,7 @@ FloatMap FilterDepthMapByConsistency(const FusionView& ref,
       if (!(depth > 0)) continue;
       ++num_checked;
       const Eigen::Vector3d world = ref.BackProject(col, row, depth);
-      const Eigen::Vector2d centre(col + 0.5, row + 0.5);
+      const Eigen::Vector2d centre = ref.PixelCentre(col, row);
       const Eigen::Vector3d to_ref = (ref_center - world).normalized();
       int consistent = 0;
       for (size_t v = 0; v < others.size(); ++v) {

@@ -36,7 +36,8 @@ bool ForwardBackwardErrorPx(const FusionView& other, const Eigen::Vector3d& worl
 // reprojection error, so the tolerance in depth scales with the baseline). A view whose ray to
 // the point meets the reference's at less than `min_triangulation_angle_deg` does not count
 // (COLMAP's filter_min_triangulation_angle): beside the reference, it reprojects any depth onto
-// the pixel. Maps may differ in size from the images as long as each K matches its map.
+// the pixel. Maps may differ in size from the images as long as each K matches its map, and
+// hold part of them (FusionView::CropToDepth): the result is then of the reference's part.
 // The error is in the reference's pixels, as COLMAP's. Counted in the coarser view's pixels
 // instead (the tolerance times the reference's scale over the other view's at the point, where
 // above 1; a prototype at stop 60, not kept): a 960 px pair whose sources are 480 px views

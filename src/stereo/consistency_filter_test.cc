@@ -72,5 +72,42 @@ TEST(ConsistencyFilterTest, AViewBesideTheReferenceDoesNotCount) {
   EXPECT_GT(with_left.num_kept, 40 * 60);
 }
 
+// Maps held cropped to their depths (FusionView::CropToDepth, as the geometric pass holds
+// them) are filtered as the whole maps are, bit for bit: the reference's part of the result.
+TEST(ConsistencyFilterTest, MapsCroppedToTheirDepthsAreFilteredAlike) {
+  std::vector<FusionView> whole = {PlaneView(Eigen::Vector3d(0, 0, 0), 0.0),
+                                   PlaneView(Eigen::Vector3d(-0.1, 0, 0), 0.1),
+                                   PlaneView(Eigen::Vector3d(0.1, 0, 0), -0.1)};
+  // A patch too far in the reference; each map's depths in a box of its own.
+  for (int row = 20; row < 30; ++row) {
+    for (int col = 30; col < 45; ++col) whole[0].depth.At(row, col) *= 1.3f;
+  }
+  const PixelBox boxes[] = {{11, 3, 60, 50}, {5, 9, 41, 47}, {30, 0, 50, 39}};
+  for (size_t v = 0; v < whole.size(); ++v) {
+    for (int row = 0; row < 60; ++row) {
+      for (int col = 0; col < 80; ++col) {
+        if (col < boxes[v].x0 || row < boxes[v].y0 || col >= boxes[v].x0 + boxes[v].width ||
+            row >= boxes[v].y0 + boxes[v].height) {
+          whole[v].depth.At(row, col) = 0.0f;
+        }
+      }
+    }
+  }
+  std::vector<FusionView> cropped = whole;
+  for (FusionView& view : cropped) view.CropToDepth();
+  ASSERT_EQ(cropped[0].depth.Width(), 60);
+  ConsistencyFilterStats whole_stats, cropped_stats;
+  const FloatMap from_whole =
+      FilterDepthMapByConsistency(whole[0], {&whole[1], &whole[2]}, 1.0, 1, 3.0, &whole_stats);
+  const FloatMap from_cropped = FilterDepthMapByConsistency(
+      cropped[0], {&cropped[1], &cropped[2]}, 1.0, 1, 3.0, &cropped_stats);
+  EXPECT_EQ(cropped[0].Whole(from_cropped).Data(), from_whole.Data());
+  EXPECT_EQ(cropped_stats.num_checked, whole_stats.num_checked);
+  EXPECT_EQ(cropped_stats.num_kept, whole_stats.num_kept);
+  // The boxes and the patch drop some depths and keep others.
+  EXPECT_GT(whole_stats.num_kept, whole_stats.num_checked / 4);
+  EXPECT_LT(whole_stats.num_kept, whole_stats.num_checked - 150);
+}
+
 }  // namespace
 }  // namespace hairmvs

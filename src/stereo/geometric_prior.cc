@@ -31,6 +31,8 @@ GeometricPriorCL::GeometricPriorCL(OpenCLContext* context, const GeometricPrior&
     const std::array<int, 4> plane =
         ConcatenatedPlaneDims(view->depth.Width(), view->depth.Height(), maps.size());
     dims.insert(dims.end(), plane.begin(), plane.end());
+    dims.push_back(view->col0);
+    dims.push_back(view->row0);
     maps.insert(maps.end(), view->depth.Data().begin(), view->depth.Data().end());
   }
   depth_maps_ = ReadOnlyBuffer(context, maps);

@@ -151,5 +151,62 @@ TEST(GeometricPriorTest, KernelMatchesTheCpuReference) {
   }
 }
 
+// Maps held cropped to their depths (FusionView::CropToDepth, as the geometric pass holds
+// them) give the prior of the whole maps, bit for bit, in the kernel and in the reference.
+TEST(GeometricPriorTest, MapsCroppedToTheirDepthsGiveTheSamePrior) {
+  auto context = OpenCLContext::Create();
+  const FusionView ref = PlaneView(Eigen::Vector3d(0, 0, 0), 0.0);
+  std::vector<FusionView> whole = {PlaneView(Eigen::Vector3d(-0.1, 0.013, 0.02), 0.1),
+                                   PlaneView(Eigen::Vector3d(0.1, 0.05, -0.01), -0.1)};
+  // Depths only in a box off every edge, each map's own.
+  const PixelBox boxes[] = {{7, 5, 50, 41}, {23, 12, 44, 37}};
+  for (size_t v = 0; v < whole.size(); ++v) {
+    const PixelBox& box = boxes[v];
+    for (int row = 0; row < whole[v].depth.Height(); ++row) {
+      for (int col = 0; col < whole[v].depth.Width(); ++col) {
+        if (col < box.x0 || row < box.y0 || col >= box.x0 + box.width ||
+            row >= box.y0 + box.height) {
+          whole[v].depth.At(row, col) = 0.0f;
+        }
+      }
+    }
+  }
+  std::vector<FusionView> cropped = whole;
+  for (size_t v = 0; v < cropped.size(); ++v) {
+    cropped[v].CropToDepth();
+    EXPECT_EQ(cropped[v].col0, boxes[v].x0);
+    EXPECT_EQ(cropped[v].row0, boxes[v].y0);
+    EXPECT_EQ(cropped[v].depth.Width(), boxes[v].width);
+    EXPECT_EQ(cropped[v].depth.Height(), boxes[v].height);
+    EXPECT_EQ(cropped[v].Whole(cropped[v].depth).Data(), whole[v].depth.Data());
+  }
+  GeometricPrior whole_prior, cropped_prior;
+  for (const FusionView& view : whole) whole_prior.views.push_back(&view);
+  for (const FusionView& view : cropped) cropped_prior.views.push_back(&view);
+  for (GeometricPrior* prior : {&whole_prior, &cropped_prior}) {
+    prior->weight = 2.0;
+    prior->max_error_px = 6.0;
+  }
+  const StereoCamera camera = CameraOf(ref);
+  const DepthLabels labels(0.5, 2.0, 64, /*inverse=*/true);
+  const size_t size = static_cast<size_t>(camera.width) * camera.height * labels.num_labels;
+  std::vector<float> cpu_whole(size, 0.0f), cpu_cropped = cpu_whole, cl_whole = cpu_whole,
+                     cl_cropped = cpu_whole;
+  AddGeometricPriorCpu(whole_prior, camera, 1.0, labels, {}, 1.0f, labels.num_labels, {}, 0.5f,
+                       &cpu_whole);
+  AddGeometricPriorCpu(cropped_prior, camera, 1.0, labels, {}, 1.0f, labels.num_labels, {},
+                       0.5f, &cpu_cropped);
+  GeometricPriorCL(context.get(), whole_prior)
+      .Add(camera, 1.0, labels, {}, 1.0f, labels.num_labels, {}, 0.5f, &cl_whole);
+  GeometricPriorCL(context.get(), cropped_prior)
+      .Add(camera, 1.0, labels, {}, 1.0f, labels.num_labels, {}, 0.5f, &cl_cropped);
+  EXPECT_EQ(cpu_cropped, cpu_whole);
+  EXPECT_EQ(cl_cropped, cl_whole);
+  // The boxes cut what the views see: entries between no error and the maximum on both sides.
+  size_t partial = 0;
+  for (float cost : cpu_whole) partial += cost > 0.01f && cost < 0.99f;
+  EXPECT_GT(partial, size / 20);
+}
+
 }  // namespace
 }  // namespace hairmvs

@@ -890,9 +890,11 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       }
     }
     // Each view's latest map but the last round's: its .photometric map (read once), then
-    // each round's estimate.
+    // each round's estimate. Held cropped to their depths (FusionView::CropToDepth), as are the
+    // filtered maps and the confidences below: a large workspace's maps are all held at once.
     std::map<std::string, FusionView> latest;
-    // The last round's estimates, filtered against the maps their prior came from.
+    // The last round's estimates, filtered against the maps their prior came from, as whole
+    // maps (FusionView::Whole).
     struct FilteredMap {
       FloatMap depth;
       Eigen::Matrix3d K;
@@ -949,6 +951,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           view.K = camera.ScaledToMap(view.depth.Width(), view.depth.Height(), path).K;
           view.R = camera.R;
           view.t = camera.t;
+          view.CropToDepth();
         }
         it = latest.emplace(name, std::move(view)).first;
       }
@@ -992,7 +995,13 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       if (max_rounds > 1) task << ", round " << round + 1 << " of at most " << max_rounds;
       Progress round_progress(task.str(), static_cast<int>(to_filter.size()));
       std::map<std::string, FusionView> next;
-      std::map<std::string, FloatMap> confidences;
+      // Each confidence map as the box of its non-zero values.
+      struct CroppedConfidence {
+        FloatMap part;
+        PixelBox box;
+        int whole_width, whole_height;
+      };
+      std::map<std::string, CroppedConfidence> confidences;
       for (size_t i = 0; i < to_filter.size(); ++i) {
         const std::string& name = to_filter[i];
         round_progress.Start(static_cast<int>(i), name);
@@ -1015,11 +1024,18 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         }
         if (std::optional<ViewEstimate> view =
                 estimate_view(name, &round_progress, &prior, cache)) {
-          FusionView estimate = *maps.ref;
-          estimate.depth = std::move(view->estimate.depth);
+          FusionView estimate;
+          estimate.name = name;
+          estimate.R = maps.ref->R;
+          estimate.t = maps.ref->t;
           estimate.K = view->K;
+          estimate.depth = std::move(view->estimate.depth);
+          estimate.CropToDepth();
           next.emplace(name, std::move(estimate));
-          confidences.emplace(name, std::move(view->estimate.confidence));
+          const FloatMap& confidence = view->estimate.confidence;
+          const PixelBox box = BoundingBoxAbove(confidence, 0.0f);
+          confidences[name] = {CropFloatMap(confidence, box.x0, box.y0, box.width, box.height),
+                               box, confidence.Width(), confidence.Height()};
         }
         if (last_possible_round) first_estimates.erase(name);
       }
@@ -1032,10 +1048,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         ScopedStageTimer timer(timings, "consistency");
         for (const auto& [name, estimate] : next) {
           FilteredMap& map = filtered[name];
-          map.depth = FilterDepthMapByConsistency(
+          map.depth = estimate.Whole(FilterDepthMapByConsistency(
               estimate, maps_of(name).others, options.geom_consistency_max_error_px,
               options.geom_consistency_min_views,
-              options.geom_consistency_min_triangulation_angle_deg, &map.stats);
+              options.geom_consistency_min_triangulation_angle_deg, &map.stats));
           map.K = estimate.K;
           total.num_checked += map.stats.num_checked;
           total.num_kept += map.stats.num_kept;
@@ -1064,7 +1080,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       if (last_round) {
         // The confidence of the maps that are written as .geometric.
         for (const auto& [name, confidence] : confidences) {
-          WriteMat(workspace.ConfidenceMapPath(name), confidence);
+          WriteMat(workspace.ConfidenceMapPath(name),
+                   UncropFloatMap(confidence.part, confidence.box.x0, confidence.box.y0,
+                                  confidence.whole_width, confidence.whole_height));
         }
         final_maps = std::move(filtered);
         break;
@@ -1097,7 +1115,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                      << "yet; its .geometric map is unfiltered (run again with "
                      << "--OrientationStereo.geom_consistency_only 1 once they have; " << kNoMapWhy
                      << ")";
-        depth = maps.ref->depth;
+        depth = maps.ref->Whole(maps.ref->depth);
         filtered = false;
       } else {
         if (max_rounds > 0 && others.size() < maps.num_others) {
@@ -1108,11 +1126,10 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
                        << kNoMapWhy << ")";
         }
         ScopedStageTimer timer(timings, "consistency");
-        depth = FilterDepthMapByConsistency(*maps.ref, others,
-                                            options.geom_consistency_max_error_px,
-                                            options.geom_consistency_min_views,
-                                            options.geom_consistency_min_triangulation_angle_deg,
-                                            &stats);
+        depth = maps.ref->Whole(FilterDepthMapByConsistency(
+            *maps.ref, others, options.geom_consistency_max_error_px,
+            options.geom_consistency_min_views,
+            options.geom_consistency_min_triangulation_angle_deg, &stats));
       }
       if (filtered) {
         std::printf("  %s: %lld of %lld depths consistent with the maps of %d other view(s)\n",
