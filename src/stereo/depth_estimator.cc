@@ -377,7 +377,7 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
         if (strand_plane_from_hull && cost == StereoCost::kOrientation) {
           ref_in.log_depth_gradient = LogDepthGradient(
               visual_hull_entry, l, ref_in.field.Width(), ref_in.field.Height(),
-              ref.camera.K(0, 0), options.max_strand_plane_tilt_deg);
+              ref.camera.K(0, 0), ref.camera.K(1, 1), options.max_strand_plane_tilt_deg);
         }
         std::vector<CostViewInput> src_in;
         for (int s = 0; s < num_sources; ++s) {

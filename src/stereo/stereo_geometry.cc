@@ -102,12 +102,12 @@ int NearestLevel0Pixel(int index, int level, int size0) {
 }
 
 FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
-                          double focal_px, double max_tilt_deg) {
+                          double focal_x_px, double focal_y_px, double max_tilt_deg) {
   CHECK_EQ(depth0.Channels(), 1);
   FloatMap gradient(width, height, 2, 0.0f);
   const int scale = 1 << level;
   const int step = std::max(2, scale);
-  const double max_norm = std::tan(max_tilt_deg * M_PI / 180.0) / focal_px;
+  const double max_tangent = std::tan(max_tilt_deg * M_PI / 180.0);
   auto log_depth = [&](int r, int c, double* value) {
     if (r < 0 || c < 0 || r >= depth0.Height() || c >= depth0.Width()) return false;
     const float d = depth0.At(r, c);
@@ -125,7 +125,8 @@ FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int heig
         continue;
       }
       Eigen::Vector2d g((right - left) / (2 * step), (down - up) / (2 * step));
-      if (g.norm() > max_norm) g *= max_norm / g.norm();
+      const double tangent = Eigen::Vector2d(g.x() * focal_x_px, g.y() * focal_y_px).norm();
+      if (tangent > max_tangent) g *= max_tangent / tangent;
       gradient.At(r, c, 0) = static_cast<float>(scale * g.x());
       gradient.At(r, c, 1) = static_cast<float>(scale * g.y());
     }

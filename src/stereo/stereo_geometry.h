@@ -58,11 +58,12 @@ Eigen::Vector2d TransferDirection(const ViewProjection& projection, double depth
 // of pyramid level `level` (width x height; 2 channels, x and y, in that level's pixel units)
 // of a depth map on the level-0 grid (metres, 0 = none), by central differences over
 // +-max(2, 2^level) level-0 pixels around the level pixel's NearestLevel0Pixel;
-// 0 where one of the four has no depth. Magnitudes are clamped at tan(max_tilt_deg) /
-// focal_px (focal_px of level 0): a plane seen at max_tilt_deg from the image plane on the
-// optical axis.
+// 0 where one of the four has no depth. Clamped where the plane they make, on the optical axis,
+// would be seen at more than max_tilt_deg from the image plane: where the gradient times the
+// focal lengths (level 0's, in x and in y: the gradient per unit of normalised image
+// coordinates) is longer than tan(max_tilt_deg); its direction there kept.
 FloatMap LogDepthGradient(const FloatMap& depth0, int level, int width, int height,
-                          double focal_px, double max_tilt_deg);
+                          double focal_x_px, double focal_y_px, double max_tilt_deg);
 
 // The epipole of the camera centred at `other_center` in `camera`'s image, homogeneous
 // (K (R c + t)): z = 0 where it lies at infinity, z < 0 where `other_center` is behind.

@@ -230,26 +230,34 @@ TEST(StereoGeometry, LogDepthGradientOfAPlane) {
   };
   const Eigen::Vector3d gentle(0.3, -0.2, 1.0);  // about 20 degrees
   const FloatMap depth = depth_map(gentle);
-  const FloatMap level0 = LogDepthGradient(depth, 0, width, height, focal, 70);
+  const FloatMap level0 = LogDepthGradient(depth, 0, width, height, focal, focal, 70);
   const Eigen::Vector2d g0 = expected(gentle, 16.5, 10.5);
   EXPECT_NEAR(level0.At(10, 16, 0), g0.x(), 1e-3 * g0.norm());
   EXPECT_NEAR(level0.At(10, 16, 1), g0.y(), 1e-3 * g0.norm());
   EXPECT_EQ(level0.At(1, 16, 0), 0.0f);  // 2 px from the top: no pixel above
   // Level 1 (17 x 11): level pixel (5, 8) is nearest level-0 pixel (11, 17).
-  const FloatMap level1 = LogDepthGradient(depth, 1, 17, 11, focal, 70);
+  const FloatMap level1 = LogDepthGradient(depth, 1, 17, 11, focal, focal, 70);
   const Eigen::Vector2d g1 = 2 * expected(gentle, 17.5, 11.5);
   EXPECT_NEAR(level1.At(5, 8, 0), g1.x(), 1e-3 * g1.norm());
   EXPECT_NEAR(level1.At(5, 8, 1), g1.y(), 1e-3 * g1.norm());
   // A plane at about 79 degrees on the optical axis: clamped at tan(70 degrees) / focal, its
   // direction kept.
   const Eigen::Vector3d steep(5.0, 0.0, 1.0);
-  const FloatMap clamped = LogDepthGradient(depth_map(steep), 0, width, height, focal, 70);
+  const FloatMap clamped = LogDepthGradient(depth_map(steep), 0, width, height, focal, focal, 70);
   EXPECT_NEAR(clamped.At(10, 17, 0), -std::tan(70 * M_PI / 180) / focal, 1e-6);
   EXPECT_NEAR(clamped.At(10, 17, 1), 0.0, 1e-6);
+  // Pixels twice as tall as wide (fy = 2 fx): a gradient per pixel in y is twice the tilt it
+  // is in x, so the clamp is in y's focal length (in x's, the -0.125 here would be clamped to
+  // tan(70 degrees) / fx, twice as steep).
+  const Eigen::Vector3d steep_in_y(0.0, 5.0, 1.0);
+  const FloatMap tall = LogDepthGradient(depth_map(steep_in_y), 0, width, height, focal,
+                                         2 * focal, 70);
+  EXPECT_NEAR(tall.At(10, 16, 0), 0.0, 1e-6);
+  EXPECT_NEAR(tall.At(10, 16, 1), -std::tan(70 * M_PI / 180) / (2 * focal), 1e-6);
   // A hole: the pixels 2 px away in x and y have no gradient.
   FloatMap holed = depth;
   holed.At(10, 16) = 0;
-  const FloatMap around_hole = LogDepthGradient(holed, 0, width, height, focal, 70);
+  const FloatMap around_hole = LogDepthGradient(holed, 0, width, height, focal, focal, 70);
   EXPECT_EQ(around_hole.At(10, 14, 0), 0.0f);
   EXPECT_EQ(around_hole.At(12, 16, 1), 0.0f);
   EXPECT_NE(around_hole.At(11, 15, 0), 0.0f);
