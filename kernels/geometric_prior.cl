@@ -10,8 +10,8 @@
 // view_params, per view (20 floats): K_j A (9, row-major), the last row of A (3), K_j a (3),
 // a.z (1), K_ref C (3), 0.
 // view_dims, per view (6 ints): width and height of j's depth map, offset of the map in
-// depth_maps (2 ints: hm_plane_offset), and the image pixel (col0, row0) that is the map's
-// pixel (0, 0) (a map of part of the image: FusionView::CropToDepth). A point is seen when
+// depth_maps (2 ints: hm_plane_offset), and the pixel (col0, row0) of the whole map that is the
+// map's pixel (0, 0) (a map of part of it: FusionView::CropToDepth). A point is seen when
 // X_j.z > 0 and its projection (SfM convention: pixel (c, r) covers [c, c+1) x [r, r+1)) falls
 // inside the map; j's surface on the ray is
 // S = C + (X - C) * depth_j / X_j.z, projected back by K_ref.
@@ -77,8 +77,8 @@ __kernel void geometric_prior(int width, int height, __global const float* ref_p
       if (xj_z > 0.0f) {
         const float3 uvw = d * k_a_ray + k_a;
         const float u = uvw.x / uvw.z, w = uvw.y / uvw.z;
-        // The image's pixel, then the map's: whole pixels, so that a part of the image is read
-        // exactly where the whole was.
+        // The whole map's pixel, then the part's: whole pixels, so that a part is read exactly
+        // where the whole was.
         if (u >= 0.0f && w >= 0.0f && u < (float)(col0 + map_width) &&
             w < (float)(row0 + map_height) && (int)u >= col0 && (int)w >= row0) {
           const float map_depth = map[((int)w - row0) * map_width + (int)u - col0];

@@ -98,4 +98,23 @@ inline FloatMap UncropFloatMap(const FloatMap& part, int x0, int y0, int whole_w
   return whole;
 }
 
+// A map held as one box of it, zeros around: a depth map's depths, a confidence map's
+// non-zero values (many such maps are held at once, and hair fills a fifth of a view).
+struct CroppedFloatMap {
+  FloatMap part;  // the whole map's pixels in `box`
+  PixelBox box;
+  int whole_width = 0, whole_height = 0;
+
+  // `whole` cropped to the box of its pixels whose channel 0 is above 0 (an empty part if
+  // none): what is not above 0 outside it comes back as +0.
+  static CroppedFloatMap AbovePositive(const FloatMap& whole) {
+    const PixelBox box = BoundingBoxAbove(whole, 0.0f);
+    return {CropFloatMap(whole, box.x0, box.y0, box.width, box.height), box, whole.Width(),
+            whole.Height()};
+  }
+  FloatMap Whole() const {
+    return UncropFloatMap(part, box.x0, box.y0, whole_width, whole_height);
+  }
+};
+
 }  // namespace hairmvs

@@ -42,7 +42,7 @@ FusionPoints ExtractFusionPoints(const std::vector<FusionView>& views,
     CHECK_EQ(view.normal.Channels(), 3) << view.name << ": normals are needed";
     const double focal = MeanFocalPx(view.K);
     FusionPoints& out = per_view[v];
-    // Every stride-th pixel of the image, whatever part of it the maps hold.
+    // Every stride-th pixel of the whole map, whatever part of it the view holds.
     const auto first = [stride](int origin) { return (stride - origin % stride) % stride; };
     for (int row = first(view.row0); row < view.depth.Height(); row += stride) {
       for (int col = first(view.col0); col < view.depth.Width(); col += stride) {

@@ -11,6 +11,7 @@
 
 #include "src/core/depth_geometry.h"
 #include "src/core/float_map.h"
+#include "src/core/logging.h"
 
 namespace hairmvs {
 
@@ -25,18 +26,24 @@ struct FusionView {
   // (RunTemplateFusion computes them from the depth where the workspace has no normal map).
   FloatMap normal;
   FloatMap rgb;     // 3 channels (R, G, B) in [0, 1]; empty = grey
-  // The maps may hold only the box of the image where the depth map has depths (CropToDepth):
-  // hair fills a fifth of a view, and a workspace's maps are held at once. Their pixel (0, 0)
-  // is the image's (col0, row0), of a whole_width x whole_height image (0: never cropped); K is
-  // the whole image's. The methods below take and give the maps' pixels.
+  // The maps may hold only the box of the whole map where it has depths (CropToDepth): hair
+  // fills a fifth of a view, and a workspace's maps are held at once. Their pixel (0, 0) is the
+  // whole map's (col0, row0), of whole_width x whole_height pixels (0: never cropped), and K is
+  // the whole map's (the image's, or the camera scaled to a smaller map). The methods below
+  // take and give the maps' pixels.
   int col0 = 0, row0 = 0;
   int whole_width = 0, whole_height = 0;
 
-  // Crops depth and the normal and rgb maps that are not empty to the box of the depth map's
-  // depths (nothing if it has none). Every method reads outside the box as no depth, as it
-  // read the zeros there, and at the same image positions: the results are the same, bit for
-  // bit.
+  // Crops depth and the normal and rgb maps that are not empty (each of the depth map's size)
+  // to the box of the depth map's depths (nothing if it has none). Every method reads outside
+  // the box as no depth, as it read the values not above 0 there, and at the same positions
+  // of the whole map: the results are the same, bit for bit.
   void CropToDepth() {
+    for (const FloatMap* map : {&normal, &rgb}) {
+      CHECK(map->Empty() || (map->Width() == depth.Width() && map->Height() == depth.Height()))
+          << name << ": maps of " << map->Width() << " x " << map->Height() << " and "
+          << depth.Width() << " x " << depth.Height() << " px";
+    }
     if (whole_width == 0) {
       whole_width = depth.Width();
       whole_height = depth.Height();
@@ -49,22 +56,30 @@ struct FusionView {
     col0 += box.x0;
     row0 += box.y0;
   }
-  // `part`, a map of the maps' box (e.g. a depth map filtered here), in a whole map of zeros.
-  FloatMap Whole(const FloatMap& part) const {
-    return whole_width == 0 ? part : UncropFloatMap(part, col0, row0, whole_width, whole_height);
+  // `part`, a map of the maps' box (e.g. a depth map filtered here), held as such.
+  CroppedFloatMap Part(FloatMap part) const {
+    return {std::move(part), PixelBox{col0, row0, depth.Width(), depth.Height()},
+            whole_width == 0 ? depth.Width() : whole_width,
+            whole_height == 0 ? depth.Height() : whole_height};
   }
+  // `part` in a whole map of zeros (values not above 0 outside the box come back as +0).
+  FloatMap Whole(const FloatMap& part) const { return Part(part).Whole(); }
 
   Eigen::Vector3d Center() const { return -R.transpose() * t; }
   // Projects a world point into the pixel grid (SfM convention: pixel (col,row) covers
   // [col, col+1) x [row, row+1)). Returns false behind the camera or outside the map.
   bool Project(const Eigen::Vector3d& world, int* col, int* row, double* z) const {
-    if (!ProjectToPixel(K, R, t, col0 + depth.Width(), row0 + depth.Height(), world, col, row,
-                        z)) {
+    int image_col, image_row;
+    double depth_z;
+    if (!ProjectToPixel(K, R, t, col0 + depth.Width(), row0 + depth.Height(), world,
+                        &image_col, &image_row, &depth_z) ||
+        image_col < col0 || image_row < row0) {
       return false;
     }
-    *col -= col0;
-    *row -= row0;
-    return *col >= 0 && *row >= 0;
+    *col = image_col - col0;
+    *row = image_row - row0;
+    *z = depth_z;
+    return true;
   }
   // The world point this map's camera sees at pixel (col, row) with z-depth `z`.
   Eigen::Vector3d BackProject(int col, int row, double z) const {

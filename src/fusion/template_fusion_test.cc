@@ -110,18 +110,32 @@ TEST(TemplateFusion, PointsAreSeenByTheViewsThatAgree) {
 TEST(TemplateFusion, ViewsCroppedToTheirDepthsGiveTheSamePoints) {
   testing::SceneOptions scene;
   std::vector<FusionView> whole = testing::RenderViews(testing::SphereSdf(1.0), scene);
-  for (FusionView& view : whole) {  // a colour per pixel, so that a shifted read shows
+  for (size_t v = 0; v < whole.size(); ++v) {
+    FusionView& view = whole[v];
+    // A colour per pixel, so that a shifted read shows.
     view.rgb = FloatMap(view.depth.Width(), view.depth.Height(), 3);
     for (size_t i = 0; i < view.rgb.Data().size(); ++i) view.rgb.Data()[i] = (i % 251) / 250.0f;
+    // Each view's box its own (the sphere's alone is the same in every view): a view's reads
+    // through another's offset would show.
+    for (int row = 0; row < view.depth.Height(); ++row) {
+      for (int col = 0; col < view.depth.Width(); ++col) {
+        if (row < 14 + 2 * static_cast<int>(v) || col < 26 + static_cast<int>(v)) {
+          view.depth.At(row, col) = 0.0f;
+        }
+      }
+    }
   }
   std::vector<FusionView> cropped = whole;
+  std::set<std::pair<int, int>> corners;
   int num_odd_corners = 0;
   for (FusionView& view : cropped) {
     view.CropToDepth();
     EXPECT_GT(view.col0 + view.row0, 0);
     EXPECT_LT(view.depth.NumPixels(), view.whole_width * view.whole_height);
+    corners.insert({view.col0, view.row0});
     num_odd_corners += view.col0 % 2 + view.row0 % 2;
   }
+  EXPECT_EQ(corners.size(), cropped.size());
   EXPECT_GT(num_odd_corners, 0);
   for (const int stride : {1, 2, 3}) {
     TemplateFusionOptions options = TestOptions();

@@ -840,11 +840,8 @@ DepthEstimate EstimateDepthMap(OpenCLContext* context, const StereoViewData& ref
       EstimateDepthMapOnGrid(context, part, sources, part_mask, part_hull, labels, options,
                              timings, progress, prior, coarse_volume_cache);
   // Back onto the whole grid: nothing outside the crop (the mask's zeros, as on the whole grid).
-  FloatMap depth(width0, height0, 1), confidence(width0, height0, 1);
-  PasteFloatMap(estimate.depth, crop.x0, crop.y0, &depth);
-  PasteFloatMap(estimate.confidence, crop.x0, crop.y0, &confidence);
-  estimate.depth = std::move(depth);
-  estimate.confidence = std::move(confidence);
+  estimate.depth = UncropFloatMap(estimate.depth, crop.x0, crop.y0, width0, height0);
+  estimate.confidence = UncropFloatMap(estimate.confidence, crop.x0, crop.y0, width0, height0);
   FloatMap& data_term = estimate.coarse_data_term.cost;
   if (!data_term.Empty()) {
     int level = 0;

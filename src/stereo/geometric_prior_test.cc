@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 
 #include "src/opencl/opencl_context.h"
@@ -206,6 +207,27 @@ TEST(GeometricPriorTest, MapsCroppedToTheirDepthsGiveTheSamePrior) {
   size_t partial = 0;
   for (float cost : cpu_whole) partial += cost > 0.01f && cost < 0.99f;
   EXPECT_GT(partial, size / 20);
+  // And the reference's points at its depths project on both sides of each box's edges: pixels
+  // just inside and just outside are read.
+  for (size_t v = 0; v < whole.size(); ++v) {
+    int inside = 0, outside = 0;
+    for (int row = 0; row < camera.height; ++row) {
+      for (int col = 0; col < camera.width; ++col) {
+        int c, r;
+        double z;
+        const Eigen::Vector3d world = CameraOf(ref).BackProject(col, row, ref.depth.At(row, col));
+        if (!whole[v].Project(world, &c, &r, &z)) continue;
+        const PixelBox& box = boxes[v];
+        const int x1 = box.x0 + box.width, y1 = box.y0 + box.height;  // past the box
+        const bool near_an_edge = std::min({std::abs(c - box.x0), std::abs(c - x1),
+                                            std::abs(r - box.y0), std::abs(r - y1)}) <= 1;
+        if (!near_an_edge) continue;
+        (c >= box.x0 && r >= box.y0 && c < x1 && r < y1 ? inside : outside) += 1;
+      }
+    }
+    EXPECT_GT(inside, 10) << v;
+    EXPECT_GT(outside, 10) << v;
+  }
 }
 
 }  // namespace

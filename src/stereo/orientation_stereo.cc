@@ -891,12 +891,12 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     }
     // Each view's latest map but the last round's: its .photometric map (read once), then
     // each round's estimate. Held cropped to their depths (FusionView::CropToDepth), as are the
-    // filtered maps and the confidences below: a large workspace's maps are all held at once.
+    // filtered maps and the confidences below (CroppedFloatMap), whole only as they are
+    // written: a large workspace's maps are all held at once.
     std::map<std::string, FusionView> latest;
-    // The last round's estimates, filtered against the maps their prior came from, as whole
-    // maps (FusionView::Whole).
+    // The last round's estimates, filtered against the maps their prior came from.
     struct FilteredMap {
-      FloatMap depth;
+      CroppedFloatMap depth;
       Eigen::Matrix3d K;
       ConsistencyFilterStats stats;
     };
@@ -995,13 +995,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       if (max_rounds > 1) task << ", round " << round + 1 << " of at most " << max_rounds;
       Progress round_progress(task.str(), static_cast<int>(to_filter.size()));
       std::map<std::string, FusionView> next;
-      // Each confidence map as the box of its non-zero values.
-      struct CroppedConfidence {
-        FloatMap part;
-        PixelBox box;
-        int whole_width, whole_height;
-      };
-      std::map<std::string, CroppedConfidence> confidences;
+      std::map<std::string, CroppedFloatMap> confidences;
       for (size_t i = 0; i < to_filter.size(); ++i) {
         const std::string& name = to_filter[i];
         round_progress.Start(static_cast<int>(i), name);
@@ -1032,10 +1026,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           estimate.depth = std::move(view->estimate.depth);
           estimate.CropToDepth();
           next.emplace(name, std::move(estimate));
-          const FloatMap& confidence = view->estimate.confidence;
-          const PixelBox box = BoundingBoxAbove(confidence, 0.0f);
-          confidences[name] = {CropFloatMap(confidence, box.x0, box.y0, box.width, box.height),
-                               box, confidence.Width(), confidence.Height()};
+          confidences[name] = CroppedFloatMap::AbovePositive(view->estimate.confidence);
         }
         if (last_possible_round) first_estimates.erase(name);
       }
@@ -1048,7 +1039,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         ScopedStageTimer timer(timings, "consistency");
         for (const auto& [name, estimate] : next) {
           FilteredMap& map = filtered[name];
-          map.depth = estimate.Whole(FilterDepthMapByConsistency(
+          map.depth = estimate.Part(FilterDepthMapByConsistency(
               estimate, maps_of(name).others, options.geom_consistency_max_error_px,
               options.geom_consistency_min_views,
               options.geom_consistency_min_triangulation_angle_deg, &map.stats));
@@ -1080,9 +1071,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       if (last_round) {
         // The confidence of the maps that are written as .geometric.
         for (const auto& [name, confidence] : confidences) {
-          WriteMat(workspace.ConfidenceMapPath(name),
-                   UncropFloatMap(confidence.part, confidence.box.x0, confidence.box.y0,
-                                  confidence.whole_width, confidence.whole_height));
+          WriteMat(workspace.ConfidenceMapPath(name), confidence.Whole());
         }
         final_maps = std::move(filtered);
         break;
@@ -1106,7 +1095,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       ConsistencyFilterStats stats;  // of the filter that made it
       bool filtered = true;
       if (estimated_again != final_maps.end()) {  // filtered in its round
-        depth = std::move(estimated_again->second.depth);
+        depth = estimated_again->second.depth.Whole();
+        estimated_again->second.depth = CroppedFloatMap();
         K = estimated_again->second.K;
         stats = estimated_again->second.stats;
       } else if (others.empty()) {
