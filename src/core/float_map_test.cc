@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <vector>
+
 namespace hairmvs {
 namespace {
 
@@ -58,6 +61,37 @@ TEST(FloatMap, BoundingBoxAboveHoldsExactlyThePixelsAboveTheThreshold) {
   EXPECT_EQ(any.height, 4);
   EXPECT_TRUE(BoundingBoxAbove(mask, 1.0f).Empty());
   EXPECT_TRUE(BoundingBoxAbove(FloatMap(), 0.0f).Empty());
+}
+
+// A map held as the box of its positive values comes back whole: the box's values as they
+// were, +0 elsewhere (where the map held 0, -0 or negative values); one without positive
+// values comes back as zeros of its size.
+TEST(FloatMap, CroppedMapComesBackWholeWithZerosAround) {
+  FloatMap map(8, 6, 1, 0.0f);
+  map.At(1, 2) = 3.0f;
+  map.At(4, 5) = 0.5f;
+  map.At(2, 3) = -2.0f;  // inside the box: kept
+  map.At(5, 7) = -1.0f;  // outside: +0
+  map.At(0, 0) = -0.0f;
+  const CroppedFloatMap cropped = CroppedFloatMap::AbovePositive(map);
+  EXPECT_EQ(cropped.box.x0, 2);
+  EXPECT_EQ(cropped.box.y0, 1);
+  EXPECT_EQ(cropped.part.Width(), 4);
+  EXPECT_EQ(cropped.part.Height(), 4);
+  const FloatMap whole = cropped.Whole();
+  ASSERT_EQ(whole.Width(), 8);
+  ASSERT_EQ(whole.Height(), 6);
+  for (int row = 0; row < 6; ++row) {
+    for (int col = 0; col < 8; ++col) {
+      const bool inside = row >= 1 && row < 5 && col >= 2 && col < 6;
+      const float expected = inside ? map.At(row, col) : 0.0f;
+      EXPECT_EQ(whole.At(row, col), expected) << row << " " << col;
+      EXPECT_FALSE(std::signbit(whole.At(row, col)) && expected == 0.0f) << row << " " << col;
+    }
+  }
+  const CroppedFloatMap none = CroppedFloatMap::AbovePositive(FloatMap(5, 3, 1, -1.0f));
+  EXPECT_TRUE(none.box.Empty());
+  EXPECT_EQ(none.Whole().Data(), std::vector<float>(15, 0.0f));
 }
 
 }  // namespace
