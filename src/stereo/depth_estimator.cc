@@ -733,8 +733,12 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
   CHECK_EQ(mask0.Height(), height0);
   for (size_t p = 0; p < depth.Data().size(); ++p) {
     const float v = value.Data()[p];
-    bool valid = mask0.Data()[p] > 0.5f && depth.Data()[p] > 0;
-    if (options.filter_range_ends && (v < 0.5f || v > num_depths - 1.5f)) valid = false;
+    const bool in_mask = mask0.Data()[p] > 0.5f;
+    const bool at_range_end = v < 0.5f || v > num_depths - 1.5f;
+    estimate.num_in_mask += in_mask;
+    estimate.num_at_range_ends += in_mask && at_range_end;
+    bool valid = in_mask && depth.Data()[p] > 0;
+    if (options.filter_range_ends && at_range_end) valid = false;
     if (filter_by_bound && v < bound0[p]) valid = false;
     if (estimate.confidence.Data()[p] < options.min_confidence) valid = false;
     if (!valid) depth.Data()[p] = 0.0f;

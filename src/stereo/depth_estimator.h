@@ -77,6 +77,10 @@ struct DepthEstimate {
   double coarse_energy = 0;
   double fine_energy = 0;
   int num_valid = 0;
+  // The mask's pixels, and those of them whose label lies at either end of the range (outside
+  // it: dropped with filter_range_ends). Many there say the range misses the hair.
+  int num_in_mask = 0;
+  int num_at_range_ends = 0;
   // The labels' disparity step (LabelStepPxPerRadian) and the smoothness weight it gave
   // (OrientationStereoOptions::ViewLambda).
   double label_step_px = 0;

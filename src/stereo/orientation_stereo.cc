@@ -812,12 +812,32 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
                          : "";
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and "
-                "radian, lambda %.4g, %d valid pixels, MRF energy %.4g (coarse) %.4g (fine)\n",
+                "radian, lambda %.4g, %d valid pixels (%d of the mask's %d at the range's "
+                "ends), MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
                 depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
                 prior_maps.c_str(), estimate.label_step_px, estimate.lambda,
-                estimate.num_valid, estimate.coarse_energy, estimate.fine_energy);
+                estimate.num_valid, estimate.num_at_range_ends, estimate.num_in_mask,
+                estimate.coarse_energy, estimate.fine_energy);
     std::fflush(stdout);
+    // Hair at the range's ends lies outside it: a range that cuts the hair off. Said of the
+    // first estimate (the geometric pass keeps its range), where a mask says what is hair:
+    // without one, the background may lie beyond any range. (0 of any view's mask pixels on
+    // both shared sets; g2_c of synth_straight_gantry, 16% of whose hair lies behind 0.54 m,
+    // 5.1% with depth_max 0.54, the rest drawn inside the range.)
+    constexpr double kMaxFractionAtRangeEnds = 0.01;
+    if (prior == nullptr && !workspace.MaskPath(name).empty() && estimate.num_in_mask > 0 &&
+        estimate.num_at_range_ends > kMaxFractionAtRangeEnds * estimate.num_in_mask) {
+      LOG(WARNING) << name << ": " << estimate.num_at_range_ends << " of the mask's "
+                   << estimate.num_in_mask << " pixels lie at the ends of the depth range, "
+                   << depth_min << "-" << depth_max << " m (" << search.range_source
+                   << ")" << (options.filter_range_ends ? ", and get no depth" : "")
+                   << ": the range may cut the hair off. Check "
+                   << (search.range_source == "options"
+                           ? "--OrientationStereo.depth_min and depth_max"
+                           : "the sparse points and the masks, or give "
+                             "--OrientationStereo.depth_min and depth_max");
+    }
     return ViewEstimate{std::move(estimate), ref.camera.K};
   };
   // The same, with the view and stage named in an error that does not name the view: a failed

@@ -416,6 +416,42 @@ TEST(OrientationStereoWorkspace, EmptyMapsAreWarnedAbout) {
   std::filesystem::remove_all(path);
 }
 
+// A depth range that cuts the masked hair off is said: the pixels at its ends are counted.
+TEST(OrientationStereoWorkspace, ARangeThatCutsTheHairOffIsWarnedAbout) {
+  const std::string path = MakeTestDir("stereo_range_cuts_hair");
+  const std::vector<FloatMap> true_depths = WriteWorkspace(path);
+  WriteLeftHalfMasks(JoinPaths(path, "masks"));
+  OrientationStereoOptions options = PlaneOptions();
+  options.geom_consistency = false;
+  // The plane's depths in the masked half of v0: half of them behind the range's end.
+  std::vector<float> depths;
+  for (int row = 0; row < 72; ++row) {
+    for (int col = 0; col < 48; ++col) depths.push_back(true_depths[0].At(row, col));
+  }
+  std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
+  options.depth_max = depths[depths.size() / 2];
+  StageTimings timings;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  std::string log = ::testing::internal::GetCapturedStderr();
+  EXPECT_NE(log.find("v0.png: "), std::string::npos) << log;
+  EXPECT_NE(log.find(" of the mask's 3456 pixels lie at the ends of the depth range, 0.7-"),
+            std::string::npos)
+      << log;
+  EXPECT_NE(log.find("m (options), and get no depth: the range may cut the hair off. Check "
+                     "--OrientationStereo.depth_min and depth_max"),
+            std::string::npos)
+      << log;
+  // The range around the whole plane: nothing said.
+  options = PlaneOptions();
+  options.geom_consistency = false;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("lie at the ends of the depth range"), std::string::npos) << log;
+  std::filesystem::remove_all(path);
+}
+
 // skip_existing (colmap patch_match_stereo's behaviour): a view whose .geometric maps exist is
 // left as it is, one whose .photometric maps exist starts at the geometric pass, the others are
 // estimated, as an interrupted run would need.
