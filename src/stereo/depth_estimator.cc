@@ -735,8 +735,11 @@ DepthEstimate EstimateDepthMapOnGrid(OpenCLContext* context, const StereoViewDat
     const float v = value.Data()[p];
     const bool in_mask = mask0.Data()[p] > 0.5f;
     const bool at_range_end = v < 0.5f || v > num_depths - 1.5f;
+    const bool hull_behind_range = !bound0.empty() && bound0[p] > num_depths - 1.5f;
+    const bool at_far_end = v > num_depths - 1.5f || hull_behind_range;
     estimate.num_in_mask += in_mask;
-    estimate.num_at_range_ends += in_mask && at_range_end;
+    estimate.num_at_far_end += in_mask && at_far_end;
+    estimate.num_at_near_end += in_mask && !at_far_end && v < 0.5f;
     bool valid = in_mask && depth.Data()[p] > 0;
     if (options.filter_range_ends && at_range_end) valid = false;
     if (filter_by_bound && v < bound0[p]) valid = false;

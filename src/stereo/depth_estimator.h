@@ -77,10 +77,13 @@ struct DepthEstimate {
   double coarse_energy = 0;
   double fine_energy = 0;
   int num_valid = 0;
-  // The mask's pixels, and those of them whose label lies at either end of the range (outside
-  // it: dropped with filter_range_ends). Many there say the range misses the hair.
+  // The mask's pixels, and those of them that lie outside the range: at its first label, or at
+  // its last or with the visual hull's entry behind it (labels dropped with filter_range_ends,
+  // and entries whose fine band the range clamps, then dropped by the hull's bound). Many such
+  // pixels say the range cuts the hair off.
   int num_in_mask = 0;
-  int num_at_range_ends = 0;
+  int num_at_near_end = 0;
+  int num_at_far_end = 0;
   // The labels' disparity step (LabelStepPxPerRadian) and the smoothness weight it gave
   // (OrientationStereoOptions::ViewLambda).
   double label_step_px = 0;

@@ -811,32 +811,49 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const std::string prior_maps =
         prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
                          : "";
+    const bool has_mask = !workspace.MaskPath(name).empty();
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and "
-                "radian, lambda %.4g, %d valid pixels (%d of the mask's %d at the range's "
-                "ends), MRF energy %.4g (coarse) %.4g (fine)\n",
+                "radian, lambda %.4g, %d valid pixels (of the %s's %d, %d at the range's near "
+                "end and %d at its far end), MRF energy %.4g (coarse) %.4g (fine)\n",
                 name.c_str(), estimate.depth.Width(), estimate.depth.Height(), depth_min,
                 depth_max, search.range_source.c_str(), static_cast<int>(sources.size()),
                 prior_maps.c_str(), estimate.label_step_px, estimate.lambda,
-                estimate.num_valid, estimate.num_at_range_ends, estimate.num_in_mask,
-                estimate.coarse_energy, estimate.fine_energy);
+                estimate.num_valid, has_mask ? "mask" : "image", estimate.num_in_mask,
+                estimate.num_at_near_end, estimate.num_at_far_end, estimate.coarse_energy,
+                estimate.fine_energy);
     std::fflush(stdout);
     // Hair at the range's ends lies outside it: a range that cuts the hair off. Said of the
     // first estimate (the geometric pass keeps its range), where a mask says what is hair:
-    // without one, the background may lie beyond any range. (0 of any view's mask pixels on
-    // both shared sets; g2_c of synth_straight_gantry, 16% of whose hair lies behind 0.54 m,
-    // 5.1% with depth_max 0.54, the rest drawn inside the range.)
-    constexpr double kMaxFractionAtRangeEnds = 0.01;
-    if (prior == nullptr && !workspace.MaskPath(name).empty() && estimate.num_in_mask > 0 &&
-        estimate.num_at_range_ends > kMaxFractionAtRangeEnds * estimate.num_in_mask) {
-      LOG(WARNING) << name << ": " << estimate.num_at_range_ends << " of the mask's "
-                   << estimate.num_in_mask << " pixels lie at the ends of the depth range, "
-                   << depth_min << "-" << depth_max << " m (" << search.range_source
-                   << ")" << (options.filter_range_ends ? ", and get no depth" : "")
-                   << ": the range may cut the hair off. Check "
-                   << (search.range_source == "options"
-                           ? "--OrientationStereo.depth_min and depth_max"
-                           : "the sparse points and the masks, or give "
-                             "--OrientationStereo.depth_min and depth_max");
+    // without one, the background may lie beyond any range.
+    constexpr double kMaxFractionOutsideRange = 0.01;
+    const int num_near = estimate.num_at_near_end, num_far = estimate.num_at_far_end;
+    if (prior == nullptr && has_mask && estimate.num_in_mask > 0 &&
+        num_near + num_far > kMaxFractionOutsideRange * estimate.num_in_mask) {
+      // Each end with where its bound came from: given, or the computed range's source.
+      const bool near_given = options.depth_min > 0, far_given = options.depth_max > 0;
+      std::ostringstream ends;
+      ends << std::fixed << std::setprecision(4);
+      if (num_near > 0) {
+        ends << num_near << " its near end, " << depth_min << " m ("
+             << (near_given ? "depth_min given" : search.range_source) << ")";
+      }
+      if (num_near > 0 && num_far > 0) ends << ", and ";
+      if (num_far > 0) {
+        ends << num_far << " its far end, " << depth_max << " m ("
+             << (far_given ? "depth_max given" : search.range_source) << ")";
+      }
+      std::string advice;
+      if ((num_near > 0 && near_given) || (num_far > 0 && far_given)) {
+        advice = "move the depth bound given";
+      }
+      if ((num_near > 0 && !near_given) || (num_far > 0 && !far_given)) {
+        advice += std::string(advice.empty() ? "" : "; ") +
+                  "check the masks (one that misses hair carves it off the visual hull) and "
+                  "the sparse points, or give the depth bounds (depth_min, depth_max)";
+      }
+      LOG(WARNING) << name << ": " << num_near + num_far << " of the mask's "
+                   << estimate.num_in_mask << " pixels reach the ends of the depth range: "
+                   << ends.str() << ". The range may cut the hair off: " << advice;
     }
     return ViewEstimate{std::move(estimate), ref.camera.K};
   };

@@ -246,9 +246,10 @@ TEST(StereoGeometry, LogDepthGradientOfAPlane) {
   const FloatMap clamped = LogDepthGradient(depth_map(steep), 0, width, height, focal, focal, 70);
   EXPECT_NEAR(clamped.At(10, 17, 0), -std::tan(70 * M_PI / 180) / focal, 1e-6);
   EXPECT_NEAR(clamped.At(10, 17, 1), 0.0, 1e-6);
-  // Pixels twice as tall as wide (fy = 2 fx): a gradient per pixel in y is twice the tilt it
-  // is in x, so the clamp is in y's focal length (in x's, the -0.125 here would be clamped to
-  // tan(70 degrees) / fx, twice as steep).
+  // Pixels half as tall as wide (fy = 2 fx): a gradient per pixel in y is a tilt's tangent twice
+  // what it is in x, so the clamp is in y's focal length (in x's, the -0.125 here would be
+  // clamped to tan(70 degrees) / fx, a gradient twice as large: a tangent of 5.5 in y, 80
+  // degrees).
   const Eigen::Vector3d steep_in_y(0.0, 5.0, 1.0);
   const FloatMap tall = LogDepthGradient(depth_map(steep_in_y), 0, width, height, focal,
                                          2 * focal, 70);

@@ -8,6 +8,9 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <regex>
+#include <sstream>
 #include <utility>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -416,39 +419,72 @@ TEST(OrientationStereoWorkspace, EmptyMapsAreWarnedAbout) {
   std::filesystem::remove_all(path);
 }
 
-// A depth range that cuts the masked hair off is said: the pixels at its ends are counted.
+// A depth range that cuts the masked hair off is said, once per view (by its first estimate),
+// with each end's count and where its bound came from; a range around the hair, or a view
+// without a mask, says nothing.
 TEST(OrientationStereoWorkspace, ARangeThatCutsTheHairOffIsWarnedAbout) {
   const std::string path = MakeTestDir("stereo_range_cuts_hair");
   const std::vector<FloatMap> true_depths = WriteWorkspace(path);
   WriteLeftHalfMasks(JoinPaths(path, "masks"));
-  OrientationStereoOptions options = PlaneOptions();
-  options.geom_consistency = false;
-  // The plane's depths in the masked half of v0: half of them behind the range's end.
+  // The plane's depths in the masked half of v0: half of them behind the range's far end.
   std::vector<float> depths;
   for (int row = 0; row < 72; ++row) {
     for (int col = 0; col < 48; ++col) depths.push_back(true_depths[0].At(row, col));
   }
   std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
-  options.depth_max = depths[depths.size() / 2];
+  const float median_depth = depths[depths.size() / 2];
+  auto count = [](const std::string& log, const std::string& text) {
+    size_t n = 0;
+    for (size_t at = log.find(text); at != std::string::npos; at = log.find(text, at + 1)) ++n;
+    return n;
+  };
+  // The pixels v0's warning says reach the far end `far_end` (0 without such a warning).
+  auto behind_far_end = [](const std::string& log, const std::string& far_end) {
+    std::smatch match;
+    const std::regex warning("v0\\.png: (\\d+) of the mask's 3456 pixels reach the ends of the "
+                             "depth range: \\1 its far end, " + far_end + " m ");
+    return std::regex_search(log, match, warning) ? std::stoi(match[1]) : 0;
+  };
   StageTimings timings;
+  // The geometric pass keeps the range and says nothing more.
+  OrientationStereoOptions options = PlaneOptions();
+  options.depth_max = median_depth;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {"v0.png", "v1.png"}, options, &timings);
+  std::string log = ::testing::internal::GetCapturedStderr();
+  // v1's masked half lies within the range.
+  EXPECT_EQ(count(log, "pixels reach the ends of the depth range: "), 1u) << log;
+  std::ostringstream far_end;
+  far_end << std::fixed << std::setprecision(4) << median_depth;
+  EXPECT_GT(behind_far_end(log, far_end.str()), 3456 / 4) << log;
+  EXPECT_NE(log.find(" m (depth_max given). The range may cut the hair off: move the depth bound "
+                     "given\n"),
+            std::string::npos)
+      << log;
+  // Both bounds in front of the plane: behind the far end wherever the hull's entry is, or the
+  // labels reach the far end (the rest take depths inside the range: its side lobes).
+  options = PlaneOptions();
+  options.geom_consistency = false;
+  options.depth_min = 0.3;
+  options.depth_max = 0.6;
   ::testing::internal::CaptureStderr();
   RunOrientationStereo(path, {"v0.png"}, options, &timings);
-  std::string log = ::testing::internal::GetCapturedStderr();
-  EXPECT_NE(log.find("v0.png: "), std::string::npos) << log;
-  EXPECT_NE(log.find(" of the mask's 3456 pixels lie at the ends of the depth range, 0.7-"),
-            std::string::npos)
-      << log;
-  EXPECT_NE(log.find("m (options), and get no depth: the range may cut the hair off. Check "
-                     "--OrientationStereo.depth_min and depth_max"),
-            std::string::npos)
-      << log;
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_GT(behind_far_end(log, "0\\.6000"), 3456 / 2) << log;
   // The range around the whole plane: nothing said.
   options = PlaneOptions();
   options.geom_consistency = false;
   ::testing::internal::CaptureStderr();
   RunOrientationStereo(path, {"v0.png"}, options, &timings);
   log = ::testing::internal::GetCapturedStderr();
-  EXPECT_EQ(log.find("lie at the ends of the depth range"), std::string::npos) << log;
+  EXPECT_EQ(log.find("the ends of the depth range"), std::string::npos) << log;
+  // No mask: the background may lie anywhere, and nothing is said of it.
+  std::filesystem::remove_all(JoinPaths(path, "masks"));
+  options.depth_max = median_depth;
+  ::testing::internal::CaptureStderr();
+  RunOrientationStereo(path, {"v0.png"}, options, &timings);
+  log = ::testing::internal::GetCapturedStderr();
+  EXPECT_EQ(log.find("the ends of the depth range"), std::string::npos) << log;
   std::filesystem::remove_all(path);
 }
 
