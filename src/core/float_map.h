@@ -99,7 +99,7 @@ inline FloatMap UncropFloatMap(const FloatMap& part, int x0, int y0, int whole_w
 }
 
 // A map held as one box of it, zeros around: a depth map's depths, a confidence map's
-// non-zero values (many such maps are held at once, and hair fills a fifth of a view).
+// positive values (many such maps are held at once, and hair fills a fifth of a view).
 struct CroppedFloatMap {
   FloatMap part;  // the whole map's pixels in `box`
   PixelBox box;

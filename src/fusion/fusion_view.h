@@ -85,7 +85,7 @@ struct FusionView {
   Eigen::Vector3d BackProject(int col, int row, double z) const {
     return BackProjectPixelToWorld(K, R, t, col + col0, row + row0, z);
   }
-  // The image position of the centre of pixel (col, row) (SfM convention).
+  // The centre of pixel (col, row) in the whole map's image coordinates (SfM convention).
   Eigen::Vector2d PixelCentre(int col, int row) const {
     return Eigen::Vector2d(col + col0 + 0.5, row + row0 + 0.5);
   }
