@@ -231,4 +231,22 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
   return true;
 }
 
+bool DepthRangeOfEstimate(const FloatMap& depth, double margin_factor, int min_depths,
+                          double* min_m, double* max_m) {
+  CHECK_GE(margin_factor, 1.0);
+  std::vector<float> depths;
+  for (float d : depth.Data()) {
+    if (d > 0) depths.push_back(d);
+  }
+  if (depths.empty() || static_cast<int>(depths.size()) < min_depths) return false;
+  const auto percentile = [&](double fraction) {
+    const size_t i = static_cast<size_t>(fraction * (depths.size() - 1));
+    std::nth_element(depths.begin(), depths.begin() + i, depths.end());
+    return static_cast<double>(depths[i]);
+  };
+  *min_m = percentile(0.01) / margin_factor;
+  *max_m = percentile(0.99) * margin_factor;
+  return true;
+}
+
 }  // namespace hairmvs

@@ -115,4 +115,12 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
                              double* min_m, double* max_m, HullRangeSource* source,
                              const VisualHullRangeOptions& options = VisualHullRangeOptions());
 
+// The range of a depth map's depths (> 0): their 1st to 99th percentile, widened by
+// `margin_factor` (the near end divided by it, the far end multiplied), so that a range that
+// was only known to hold the hair (HullRangeSource::kHullInFrontOfPoints: a hull that runs far
+// behind the head) can be narrowed to a first estimate. False (outputs untouched) with fewer
+// than `min_depths` depths.
+bool DepthRangeOfEstimate(const FloatMap& depth, double margin_factor, int min_depths,
+                          double* min_m, double* max_m);
+
 }  // namespace hairmvs

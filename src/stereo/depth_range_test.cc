@@ -258,6 +258,25 @@ TEST(DepthRangeTest, HullAndPointsRangeSearchesNearerWhenThePointsLieBehindTheHu
 // Masks that keep whole images carve nothing: searched nearer, only the views' frusta would
 // cut the hull's near ends (up to where they meet, near the views), so the first search's
 // range stands.
+// The range of an estimate: the 1st to 99th percentile of its depths (the strays beyond left
+// out), widened by the margin factor both ways; too few depths give none.
+TEST(DepthRangeTest, RangeOfAnEstimateSpansItsDepthsWithAMargin) {
+  FloatMap depth(50, 40, 1, 0.0f);  // 2000 pixels: 1000 depths from 0.5 to 0.6 m, 2 strays
+  for (int i = 0; i < 1000; ++i) depth.Data()[2 * i] = 0.5f + 0.1f * i / 999.0f;
+  depth.Data()[1] = 0.05f;
+  depth.Data()[3] = 9.0f;
+  double min_m = 0, max_m = 0;
+  ASSERT_TRUE(DepthRangeOfEstimate(depth, 1.2, 100, &min_m, &max_m));
+  // Of the 1002 depths sorted, the 1st percentile is index floor(0.01 * 1001) = 10, 0.5 + 0.1 *
+  // 9 / 999 (after the stray at 0.05 m), the 99th index 990, 0.5 + 0.1 * 989 / 999.
+  EXPECT_NEAR(min_m, (0.5 + 0.1 * 9 / 999.0) / 1.2, 1e-6);
+  EXPECT_NEAR(max_m, (0.5 + 0.1 * 989 / 999.0) * 1.2, 1e-6);
+  min_m = max_m = -1;
+  EXPECT_FALSE(DepthRangeOfEstimate(depth, 1.2, 1003, &min_m, &max_m));
+  EXPECT_EQ(min_m, -1);
+  EXPECT_FALSE(DepthRangeOfEstimate(FloatMap(4, 4, 1, 0.0f), 1.2, 1, &min_m, &max_m));
+}
+
 TEST(DepthRangeTest, MasksThatCarveNothingAreNotSearchedNearer) {
   Scene scene = MakeScene(7);
   const FloatMap mask = SphereMask(scene.ref);

@@ -53,6 +53,9 @@ struct DepthSearch {
   double depth_max = 0;  // 0: not computed yet
   std::string range_source;
   FloatMap visual_hull_entry;
+  // The range is the visual hull's, searched in front of every sparse point: nothing bounds
+  // its far end but the search, so the first estimate narrows it (DepthRangeOfEstimate).
+  bool narrow_to_first_estimate = false;
 };
 
 // What the geometric pass would compute again for a view, kept from its first estimate: the
@@ -763,6 +766,9 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
           }
           if (options.depth_min <= 0) depth_min = hull_min;
           if (options.depth_max <= 0) depth_max = hull_max;
+          search.narrow_to_first_estimate =
+              hull_source == HullRangeSource::kHullInFrontOfPoints && options.depth_min <= 0 &&
+              options.depth_max <= 0;
         }
       }
       // One bound given and the other computed can cross; say which is which.
@@ -796,16 +802,55 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       search.depth_max = depth_max;
       search.range_source = range_source;
     }
-    const double depth_min = search.depth_min, depth_max = search.depth_max;
-    const DepthLabels labels(depth_min, depth_max, options.num_depths,
-                             options.depth_sampling == DepthSampling::kInverseDepth);
+    const bool inverse = options.depth_sampling == DepthSampling::kInverseDepth;
     if (prior == nullptr) {
-      WarnOfMismatchedSources(name, ref, sources, source_names, labels, options);
+      WarnOfMismatchedSources(
+          name, ref, sources, source_names,
+          DepthLabels(search.depth_min, search.depth_max, options.num_depths, inverse), options);
     }
-
-    DepthEstimate estimate = EstimateDepthMap(
-        context.get(), ref, sources, mask, search.visual_hull_entry, labels, options, timings,
-        progress, prior, cache != nullptr ? &cache->coarse_volume : nullptr);
+    auto estimate_in_range = [&] {
+      const DepthLabels labels(search.depth_min, search.depth_max, options.num_depths, inverse);
+      return EstimateDepthMap(context.get(), ref, sources, mask, search.visual_hull_entry,
+                              labels, options, timings, progress, prior,
+                              cache != nullptr ? &cache->coarse_volume : nullptr);
+    };
+    // A hull searched in front of every point runs far behind the head (a T group's cones meet
+    // along the line of sight), and its labels are coarse: the range is narrowed to the first
+    // estimate's depths, a fifth wider either way, and the first estimate made again. (The 240
+    // px T group whose sparse points lie on the room only, README: 21.5 -> 7.1 mm.) The
+    // geometric pass keeps that range where it kept the first estimate's search; where it
+    // computes the range again (past coarse_volume_cache_mib, or geom_consistency_only), it
+    // narrows it to the view's .photometric map, the first estimate made in the narrowed range.
+    constexpr double kFirstEstimateMargin = 1.2;
+    constexpr int kMinDepthsToNarrow = 100;  // fewer make noisy percentiles
+    auto narrow_to = [&](const FloatMap& first_estimate, const char* what) {
+      double narrowed_min = 0, narrowed_max = 0;
+      if (!DepthRangeOfEstimate(first_estimate, kFirstEstimateMargin, kMinDepthsToNarrow,
+                                &narrowed_min, &narrowed_max)) {
+        return false;
+      }
+      narrowed_min = std::max(narrowed_min, search.depth_min);
+      narrowed_max = std::min(narrowed_max, search.depth_max);
+      if (!(narrowed_max > narrowed_min)) return false;
+      std::printf("  %s: depth %.4f-%.4f m narrowed to %s, %.4f-%.4f m\n", name.c_str(),
+                  search.depth_min, search.depth_max, what, narrowed_min, narrowed_max);
+      search.depth_min = narrowed_min;
+      search.depth_max = narrowed_max;
+      search.range_source += ", narrowed to the first estimate";
+      search.narrow_to_first_estimate = false;
+      return true;
+    };
+    if (search.narrow_to_first_estimate && prior != nullptr) {
+      const std::string photometric = workspace.DepthMapPath(name, "photometric");
+      if (ExistsFile(photometric)) narrow_to(ReadMat(photometric), "its .photometric map's depths");
+    }
+    DepthEstimate estimate = estimate_in_range();
+    if (search.narrow_to_first_estimate && prior == nullptr &&
+        narrow_to(estimate.depth, "the first estimate's depths (estimated again)")) {
+      if (cache != nullptr) cache->coarse_volume.clear();  // the wider range's
+      estimate = estimate_in_range();
+    }
+    const double depth_min = search.depth_min, depth_max = search.depth_max;
 
     // The prior's maps: the sources' and those of the views looking the same way.
     const std::string prior_maps =
