@@ -10,6 +10,20 @@ namespace hairmvs {
 
 namespace {
 
+// The index of percentile `percent` (0-100, clamped) among `size` sorted values: the nearest
+// rank below.
+size_t PercentileIndex(size_t size, double percent) {
+  const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
+  return std::min(size - 1, static_cast<size_t>(p * (size - 1)));
+}
+
+// That percentile of `values` (not empty), which it reorders.
+double Percentile(std::vector<double>* values, double percent) {
+  const size_t i = PercentileIndex(values->size(), percent);
+  std::nth_element(values->begin(), values->begin() + i, values->end());
+  return (*values)[i];
+}
+
 // Reference camera coordinates to another view's homogeneous pixel coordinates:
 // u = K_o (R_o R_r^T (X_r - t_r) + t_o) = A X_r + c.
 struct Projection {
@@ -152,22 +166,12 @@ bool VisualHullDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
     }
   }
   if (static_cast<int>(near_ends.size()) < std::max(1, options.min_rays_in_hull)) return false;
-  // The index of a percentile among `size` sorted values.
-  const auto percentile_index = [](size_t size, double percent) {
-    const double p = std::clamp(percent, 0.0, 100.0) / 100.0;
-    return std::min(size - 1, static_cast<size_t>(p * (size - 1)));
-  };
-  const auto percentile = [&](std::vector<double>* values, double percent) {
-    const size_t i = percentile_index(values->size(), percent);
-    std::nth_element(values->begin(), values->begin() + i, values->end());
-    return (*values)[i];
-  };
-  const double lo = percentile(&near_ends, options.low_percentile);
-  const double hi = percentile(&far_ends, options.high_percentile);
+  const double lo = Percentile(&near_ends, options.low_percentile);
+  const double hi = Percentile(&far_ends, options.high_percentile);
   if (near_end != nullptr) {
     // The low percentile is the search's start when more rays than its index begin there.
     near_end->at_search_start =
-        num_at_start > percentile_index(near_ends.size(), options.low_percentile);
+        num_at_start > PercentileIndex(near_ends.size(), options.low_percentile);
     const size_t num_inside_search = near_ends.size() - num_at_start;
     near_end->fraction_cut_by_masks =
         num_inside_search > 0 ? static_cast<double>(num_cut_by_masks) / num_inside_search : 0;
@@ -234,18 +238,13 @@ bool HullAndPointsDepthRange(const StereoCamera& ref, const FloatMap& ref_mask,
 bool DepthRangeOfEstimate(const FloatMap& depth, double margin_factor, int min_depths,
                           double* min_m, double* max_m) {
   CHECK_GE(margin_factor, 1.0);
-  std::vector<float> depths;
+  std::vector<double> depths;
   for (float d : depth.Data()) {
     if (d > 0) depths.push_back(d);
   }
   if (depths.empty() || static_cast<int>(depths.size()) < min_depths) return false;
-  const auto percentile = [&](double fraction) {
-    const size_t i = static_cast<size_t>(fraction * (depths.size() - 1));
-    std::nth_element(depths.begin(), depths.begin() + i, depths.end());
-    return static_cast<double>(depths[i]);
-  };
-  *min_m = percentile(0.01) / margin_factor;
-  *max_m = percentile(0.99) * margin_factor;
+  *min_m = Percentile(&depths, 1) / margin_factor;
+  *max_m = Percentile(&depths, 99) * margin_factor;
   return true;
 }
 

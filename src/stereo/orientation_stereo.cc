@@ -715,6 +715,8 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
 
     const FloatMap mask =
         loader.Mask(name, ref.orientation[0].Width(), ref.orientation[0].Height());
+    // Whether the view has a mask file (without one, `mask` keeps every pixel).
+    const bool has_mask = !workspace.MaskPath(name).empty();
     // The depth range and the visual-hull bound, from the first estimate when the geometric
     // pass estimates the view again.
     DepthSearch computed;
@@ -731,7 +733,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       if (depth_min <= 0 || depth_max <= 0) {
         const uint32_t image_id = workspace.ImageByName(name).image_id;
         // Without a mask file the view's mask is all ones: every point counts, as COLMAP's rule.
-        const DepthRange range = options.depth_range_from_mask && !workspace.MaskPath(name).empty()
+        const DepthRange range = options.depth_range_from_mask && has_mask
                                      ? ComputeDepthRange(workspace.Model(), image_id, mask)
                                      : ComputeDepthRange(workspace.Model(), image_id);
         if (depth_min <= 0) depth_min = range.min_m;
@@ -743,7 +745,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
         hull_options.min_carving_views = options.visual_hull_min_carving_views;
         double hull_min = 0, hull_max = 0;
         HullRangeSource hull_source = HullRangeSource::kHull;
-        if (options.depth_range_from_visual_hull && !workspace.MaskPath(name).empty() &&
+        if (options.depth_range_from_visual_hull && has_mask &&
             HullAndPointsDepthRange(ref.camera, mask, others(),
                                     // Without points in the mask, `range` has all of them.
                                     range.inside_mask
@@ -785,7 +787,7 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
       // coarse labels start, and the surface whose tilt the strands' plane takes.
       if ((options.visual_hull_depth_bound != VisualHullBound::kOff ||
            options.StrandPlaneFromVisualHull() || options.coarse_labels_from_visual_hull) &&
-          !workspace.MaskPath(name).empty()) {
+          has_mask) {
         ScopedStageTimer timer(timings, "visual hull");
         VisualHullRangeOptions every_pixel_entries;
         every_pixel_entries.pixel_step = 1;
@@ -856,7 +858,6 @@ OrientationStereoResult RunOrientationStereo(const std::string& workspace_path,
     const std::string prior_maps =
         prior != nullptr ? ", a prior from " + std::to_string(prior->views.size()) + " depth maps"
                          : "";
-    const bool has_mask = !workspace.MaskPath(name).empty();
     std::printf("  %s: %d x %d, depth %.4f-%.4f m (%s), %d sources%s, %.3g px per label and "
                 "radian, lambda %.4g, %d valid pixels (of the %s's %d, %d at the range's near "
                 "end and %d at its far end), MRF energy %.4g (coarse) %.4g (fine)\n",
